@@ -1,0 +1,104 @@
+#include "job_watch.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <thread>
+
+namespace balloon::cli {
+namespace {
+
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_interrupt(int) { g_interrupted.store(true); }
+
+}  // namespace
+
+std::string state_name(balloon::v1::JobState state) {
+  switch (state) {
+    case balloon::v1::JOB_STATE_QUEUED: return "queued";
+    case balloon::v1::JOB_STATE_RUNNING: return "running";
+    case balloon::v1::JOB_STATE_COMPLETED: return "completed";
+    case balloon::v1::JOB_STATE_FAILED: return "failed";
+    case balloon::v1::JOB_STATE_CANCELLED: return "cancelled";
+    default: return "unknown";
+  }
+}
+
+bool is_final(balloon::v1::JobState state) {
+  return state == balloon::v1::JOB_STATE_COMPLETED || state == balloon::v1::JOB_STATE_FAILED ||
+         state == balloon::v1::JOB_STATE_CANCELLED;
+}
+
+WatchOutcome watch_job(ServiceConnection& connection, const std::string& job_id,
+                       const std::function<void(const balloon::v1::JobEvent&)>& on_event) {
+  WatchOutcome outcome;
+  grpc::ClientContext context;
+  connection.prepare(context);
+  balloon::v1::WatchJobRequest request;
+  request.set_job_id(job_id);
+
+  g_interrupted.store(false);
+  const auto previous = std::signal(SIGINT, on_interrupt);
+  std::atomic<bool> done{false};
+  // A blocking Read cannot see a signal: this thread turns Ctrl-C into a cancelled call.
+  std::thread monitor([&] {
+    while (!done.load()) {
+      if (g_interrupted.load()) {
+        context.TryCancel();
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
+  auto reader = connection.stub().WatchJob(&context, request);
+  balloon::v1::JobEvent event;
+  while (reader->Read(&event)) {
+    outcome.state = event.state();
+    if (!event.message().empty()) outcome.message = event.message();
+    if (event.state() == balloon::v1::JOB_STATE_COMPLETED) outcome.converged = event.converged();
+    on_event(event);
+  }
+  outcome.status = reader->Finish();
+  done.store(true);
+  monitor.join();
+  std::signal(SIGINT, previous);
+  outcome.interrupted = g_interrupted.load();
+  return outcome;
+}
+
+ProgressPrinter::ProgressPrinter(bool enabled) : m_enabled(enabled), m_terminal(isatty(STDERR_FILENO) == 1) {}
+
+ProgressPrinter::~ProgressPrinter() {
+  if (m_line_open) std::fputc('\n', stderr);
+}
+
+void ProgressPrinter::operator()(const balloon::v1::JobEvent& event) {
+  if (!m_enabled) return;
+  char line[256];
+  if (event.has_progress()) {
+    const auto& p = event.progress();
+    int n = std::snprintf(line, sizeof(line), "%s [%6.2f s] %s %d  p=%.4g kPa  residual %.2e N", event.job_id().c_str(),
+                          p.elapsed_s(), p.phase().c_str(), p.iteration(), p.pressure_kpa(), p.residual_norm());
+    if (p.avg_error_mm() >= 0 && n > 0 && n < static_cast<int>(sizeof(line)))
+      std::snprintf(line + n, sizeof(line) - static_cast<std::size_t>(n), "  error avg %.3g max %.3g mm",
+                    p.avg_error_mm(), p.max_error_mm());
+  } else {
+    // State messages read as sentences already ("started (attempt 1)", "completed: converged in 0.2 s").
+    std::snprintf(line, sizeof(line), "%s %s", event.job_id().c_str(),
+                  event.message().empty() ? state_name(event.state()).c_str() : event.message().c_str());
+  }
+  if (m_terminal && event.has_progress()) {
+    std::fprintf(stderr, "\r\033[K%s", line);
+    m_line_open = true;
+  } else {
+    if (m_line_open) std::fputc('\n', stderr);
+    m_line_open = false;
+    std::fprintf(stderr, "%s\n", line);
+  }
+  std::fflush(stderr);
+}
+
+}  // namespace balloon::cli

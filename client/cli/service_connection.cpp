@@ -1,0 +1,123 @@
+#include "service_connection.hpp"
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "exit_codes.hpp"
+#include "rpc/grpc_server.hpp"
+
+namespace balloon::cli {
+
+std::vector<OptionSpec> connection_option_specs() {
+  return {{"server"}, {"token"}, {"db"}, {"tls", false}, {"tls-ca"}};
+}
+
+const char* connection_help() {
+  return "Connection (all commands that use the service):\n"
+         "  --server HOST:PORT  a balloon-server (env BALLOON_SERVER); default: an embedded in-process server\n"
+         "  --token TOKEN       bearer token for the server (env BALLOON_TOKEN)\n"
+         "  --tls               use TLS with the system's root certificates\n"
+         "  --tls-ca FILE       use TLS trusting the PEM certificate(s) in FILE\n"
+         "  --db PATH           embedded server's database [$XDG_DATA_HOME/balloon/balloon.db]\n";
+}
+
+ConnectionOptions connection_options(const ParsedArgs& args) {
+  ConnectionOptions options;
+  const char* server_env = std::getenv("BALLOON_SERVER");
+  const char* token_env = std::getenv("BALLOON_TOKEN");
+  options.server = args.get("server").value_or(server_env != nullptr ? server_env : "");
+  options.token = args.get("token").value_or(token_env != nullptr ? token_env : "");
+  options.db = args.get("db").value_or("");
+  options.tls_ca = args.get("tls-ca").value_or("");
+  options.tls = args.has("tls") || !options.tls_ca.empty();
+  return options;
+}
+
+std::string default_database_path() {
+  std::filesystem::path base;
+  if (const char* xdg = std::getenv("XDG_DATA_HOME"); xdg != nullptr && *xdg != '\0') {
+    base = xdg;
+  } else if (const char* home = std::getenv("HOME"); home != nullptr && *home != '\0') {
+    base = std::filesystem::path(home) / ".local" / "share";
+  } else {
+    base = std::filesystem::temp_directory_path();
+  }
+  return (base / "balloon" / "balloon.db").string();
+}
+
+ServiceConnection::~ServiceConnection() {
+  m_stub.reset();
+  m_channel.reset();
+  if (m_embedded) m_embedded->shutdown(2.0);
+}
+
+Result<std::unique_ptr<ServiceConnection>> ServiceConnection::open(const ConnectionOptions& options) {
+  std::unique_ptr<ServiceConnection> connection(new ServiceConnection());
+  if (!options.server.empty()) {
+    std::shared_ptr<grpc::ChannelCredentials> credentials = grpc::InsecureChannelCredentials();
+    if (options.tls) {
+      grpc::SslCredentialsOptions ssl;
+      if (!options.tls_ca.empty()) {
+        std::ifstream in(options.tls_ca);
+        if (!in) return fail("cannot read --tls-ca '" + options.tls_ca + "'");
+        std::ostringstream pem;
+        pem << in.rdbuf();
+        ssl.pem_root_certs = pem.str();
+      }
+      credentials = grpc::SslCredentials(ssl);
+    }
+    grpc::ChannelArguments arguments;
+    arguments.SetMaxReceiveMessageSize(-1);
+    connection->m_channel = grpc::CreateCustomChannel(options.server, credentials, arguments);
+    connection->m_token = options.token;
+  } else {
+    rpc::ServerConfig config;
+    config.service.db_path = options.db.empty() ? default_database_path() : options.db;
+    config.service.run_jobs = options.run_jobs;
+    config.service.workers = 0;  // number of cores
+    // The embedded server serves one user on this machine: no limits beyond the defaults' sanity.
+    std::error_code ignored;
+    const std::filesystem::path parent = std::filesystem::path(config.service.db_path).parent_path();
+    if (!parent.empty()) std::filesystem::create_directories(parent, ignored);
+    auto server = rpc::GrpcServer::start(config);
+    if (!server && options.db.empty()) {
+      // No writable data directory (a read-only home, a bare container): keep working, without history.
+      std::fprintf(stderr, "balloon: warning: %s; using a temporary in-memory job store\n", server.error().c_str());
+      config.service.db_path = ":memory:";
+      server = rpc::GrpcServer::start(config);
+    }
+    if (!server) return fail("cannot start the embedded server: " + server.error());
+    connection->m_embedded = std::move(*server);
+    connection->m_channel = connection->m_embedded->in_process_channel();
+    connection->m_database = config.service.db_path;
+  }
+  connection->m_stub = balloon::v1::BalloonService::NewStub(connection->m_channel);
+  return connection;
+}
+
+void ServiceConnection::prepare(grpc::ClientContext& context) const {
+  if (!m_token.empty()) context.AddMetadata("authorization", "Bearer " + m_token);
+}
+
+int exit_code_for(const grpc::Status& status) {
+  switch (status.error_code()) {
+    case grpc::StatusCode::OK: return EXIT_OK;
+    case grpc::StatusCode::INVALID_ARGUMENT:
+    case grpc::StatusCode::UNIMPLEMENTED:
+    case grpc::StatusCode::OUT_OF_RANGE: return EXIT_BAD_INPUT;
+    case grpc::StatusCode::NOT_FOUND: return EXIT_NOT_FOUND;
+    case grpc::StatusCode::RESOURCE_EXHAUSTED:
+    case grpc::StatusCode::UNAVAILABLE:
+    case grpc::StatusCode::DEADLINE_EXCEEDED: return EXIT_UNAVAILABLE;
+    case grpc::StatusCode::UNAUTHENTICATED:
+    case grpc::StatusCode::PERMISSION_DENIED: return EXIT_DENIED;
+    case grpc::StatusCode::FAILED_PRECONDITION: return EXIT_NOT_READY;
+    case grpc::StatusCode::CANCELLED: return EXIT_INTERRUPTED;
+    default: return EXIT_INTERNAL;
+  }
+}
+
+}  // namespace balloon::cli

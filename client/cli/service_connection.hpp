@@ -1,0 +1,67 @@
+#pragma once
+/// How the CLI reaches the service: a remote server (--server / BALLOON_SERVER, with --token /
+/// BALLOON_TOKEN) or, by default, an embedded in-process server on a local SQLite file (same service
+/// code, no port).
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <grpcpp/grpcpp.h>
+
+#include "arg_parser.hpp"
+#include "balloon/v1/balloon.grpc.pb.h"
+#include "result.hpp"
+
+namespace balloon::rpc {
+class GrpcServer;
+}
+
+namespace balloon::cli {
+
+struct ConnectionOptions {
+  std::string server;    ///< HOST:PORT; empty: embedded server
+  std::string token;     ///< bearer token for a remote server
+  std::string db;        ///< embedded server's database; empty: $XDG_DATA_HOME/balloon/balloon.db
+  std::string tls_ca;    ///< PEM root certificate(s) for TLS to a remote server
+  bool tls = false;      ///< TLS with the system roots
+  bool run_jobs = true;  ///< embedded server: start workers (commands that wait for jobs)
+};
+
+/// The options every service command accepts: --server, --token, --db, --tls, --tls-ca.
+std::vector<OptionSpec> connection_option_specs();
+/// Reads them (falling back to BALLOON_SERVER and BALLOON_TOKEN).
+ConnectionOptions connection_options(const ParsedArgs& args);
+/// The text documenting them, for each command's --help.
+const char* connection_help();
+
+/// The embedded server's default database: $XDG_DATA_HOME/balloon/balloon.db, else
+/// ~/.local/share/balloon/balloon.db.
+std::string default_database_path();
+
+class ServiceConnection {
+ public:
+  /// Connects (remote) or starts the embedded server. Errors name the problem.
+  static Result<std::unique_ptr<ServiceConnection>> open(const ConnectionOptions& options);
+  ~ServiceConnection();
+
+  balloon::v1::BalloonService::Stub& stub() { return *m_stub; }
+  /// Adds the token to a call's metadata.
+  void prepare(grpc::ClientContext& context) const;
+  /// True for the embedded server.
+  bool embedded() const { return m_embedded != nullptr; }
+  /// Where the embedded server keeps its data (empty for a remote server).
+  const std::string& database() const { return m_database; }
+
+ private:
+  ServiceConnection() = default;
+  std::unique_ptr<rpc::GrpcServer> m_embedded;
+  std::shared_ptr<grpc::Channel> m_channel;
+  std::unique_ptr<balloon::v1::BalloonService::Stub> m_stub;
+  std::string m_token;
+  std::string m_database;
+};
+
+/// The CLI exit code for a failed call (exit_codes.hpp).
+int exit_code_for(const grpc::Status& status);
+
+}  // namespace balloon::cli

@@ -1,0 +1,177 @@
+/// `balloon simulate`: inflate a rest mesh and report the equilibrium (issue 2's CLI contract), run as
+/// a job through the service (embedded by default, or --server).
+#include <google/protobuf/struct.pb.h>
+#include <google/protobuf/util/json_util.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include "cli_output.hpp"
+#include "commands.hpp"
+#include "exit_codes.hpp"
+#include "job_watch.hpp"
+#include "service_connection.hpp"
+#include "simulate_request.hpp"
+
+namespace balloon::cli {
+namespace {
+
+namespace v1 = balloon::v1;
+
+constexpr const char* COMMAND = "simulate";
+
+constexpr const char* HELP =
+    "Usage: balloon simulate REST_MESH --material SPEC [--thickness MM]\n"
+    "                        (--pressure KPA | --volume-ratio R) [--out FILE] [--json]\n\n"
+    "Inflates the closed rest mesh REST_MESH (OBJ, STL, PLY, OFF, glTF/GLB; coordinates in mm) to\n"
+    "static equilibrium, either under a given pressure or to a given enclosed-volume ratio. Runs as a job\n"
+    "on the service (an embedded one unless --server is given); on a terminal, progress goes to stderr.\n\n"
+    "Options:\n"
+    "  --material SPEC     rubber law: neo-hookean:mu=0.3 | mooney-rivlin:C1=0.18,C2=0.02 |\n"
+    "                      hart-smith:G=0.1,k1=3e-4,k2=1.0 (moduli in MPa) | preset: silicone, latex |\n"
+    "                      the name of a stored material (balloon materials list)\n"
+    "  --thickness MM      rest membrane thickness in mm (default 0.5)\n"
+    "  --pressure KPA      inflate under this pressure (kPa, > 0)\n"
+    "  --volume-ratio R    inflate until V / V_rest = R (> 0); passes pressure maxima\n"
+    "  --out FILE          write the inflated mesh (.obj, .stl or .ply), only if the run converged\n"
+    "  --json              print one JSON object on stdout instead of a summary\n"
+    "  --help              this text\n\n"
+    "JSON keys: converged, pressure_kpa, volume_mm3, rest_volume_mm3, volume_ratio, mean_stretch,\n"
+    "max_stretch, newton_iterations, factorizations, load_steps, residual_norm (N), time_s, vertices,\n"
+    "faces, material, material_name, thickness_mm, control, flipped_orientation, message.\n\n"
+    "Exit codes: 0 converged, 2 bad input (one line on stderr names it), 3 not converged (the result is\n"
+    "still printed, no --out file), 5 server unreachable or busy, 6 not allowed, 8 the job failed,\n"
+    "130 interrupted (the job is cancelled), 1 internal error.\n\n";
+
+double number_field(const google::protobuf::Struct& report, const std::string& key) {
+  const auto it = report.fields().find(key);
+  return it == report.fields().end() ? 0.0 : it->second.number_value();
+}
+
+std::string string_field(const google::protobuf::Struct& report, const std::string& key) {
+  const auto it = report.fields().find(key);
+  return it == report.fields().end() ? std::string() : it->second.string_value();
+}
+
+std::string format(const char* pattern, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), pattern, value);
+  return buffer;
+}
+
+/// The human summary, from the report JSON the service returns.
+std::string summary_from_report(const std::string& report_json) {
+  google::protobuf::Struct report;
+  if (!google::protobuf::util::JsonStringToMessage(report_json, &report).ok()) return report_json + "\n";
+  const auto flag = [&](const std::string& key) {
+    const auto it = report.fields().find(key);
+    return it != report.fields().end() && it->second.bool_value();
+  };
+  std::ostringstream out;
+  out << (flag("converged") ? "converged" : "NOT converged") << " after " << number_field(report, "newton_iterations")
+      << " Newton iterations (" << number_field(report, "load_steps") << " load steps, "
+      << number_field(report, "factorizations") << " factorizations) in " << format("%.3f", number_field(report, "time_s"))
+      << " s\n";
+  if (const std::string message = string_field(report, "message"); !message.empty()) out << "  " << message << "\n";
+  out << "  material       " << string_field(report, "material");
+  if (const std::string name = string_field(report, "material_name"); !name.empty()) out << " (" << name << ")";
+  out << ", thickness " << format("%.6g", number_field(report, "thickness_mm")) << " mm\n";
+  out << "  mesh           " << number_field(report, "vertices") << " vertices, " << number_field(report, "faces")
+      << " faces" << (flag("flipped_orientation") ? " (flipped to face outwards)" : "") << "\n";
+  out << "  pressure       " << format("%.6g", number_field(report, "pressure_kpa")) << " kPa\n";
+  out << "  volume         " << format("%.6g", number_field(report, "volume_mm3")) << " mm^3 (rest "
+      << format("%.6g", number_field(report, "rest_volume_mm3")) << " mm^3, ratio "
+      << format("%.6g", number_field(report, "volume_ratio")) << ")\n";
+  out << "  stretch        mean " << format("%.6g", number_field(report, "mean_stretch")) << ", max "
+      << format("%.6g", number_field(report, "max_stretch")) << "\n";
+  out << "  residual norm  " << format("%.3e", number_field(report, "residual_norm")) << " N\n";
+  return out.str();
+}
+
+}  // namespace
+
+int run_simulate_command(const std::vector<std::string>& args) {
+  std::vector<OptionSpec> options = simulate_option_specs();
+  for (const OptionSpec& spec : connection_option_specs()) options.push_back(spec);
+  options.push_back({"out"});
+  options.push_back({"json", false});
+  options.push_back({"help", false});
+  Result<ParsedArgs> parsed = parse_args(args, options);
+  if (!parsed) return report_error(COMMAND, parsed.error(), EXIT_BAD_INPUT);
+  if (parsed->has("help")) {
+    std::fputs(HELP, stdout);
+    std::fputs(connection_help(), stdout);
+    return EXIT_OK;
+  }
+  // Every local check comes before any connection, so the cheapest problems are reported first.
+  const std::optional<std::string> out_path = parsed->get("out");
+  Result<v1::SubmitJobRequest> request = simulate_request_from_args(*parsed);
+  if (!request) return report_error(COMMAND, request.error(), EXIT_BAD_INPUT);
+  if (out_path) {
+    if (const std::string problem = mesh_output_problem(*out_path); !problem.empty())
+      return report_error(COMMAND, "--out: " + problem, EXIT_BAD_INPUT);
+  }
+  const std::string mesh_path = parsed->positionals.front();
+
+  auto connection = ServiceConnection::open(connection_options(*parsed));
+  if (!connection) return report_error(COMMAND, connection.error(), EXIT_UNAVAILABLE);
+
+  v1::SubmitJobResponse submitted;
+  {
+    grpc::ClientContext context;
+    (*connection)->prepare(context);
+    const grpc::Status status = (*connection)->stub().SubmitJob(&context, *request, &submitted);
+    if (!status.ok()) {
+      std::string message = status.error_message();
+      if (message.rfind("rest_mesh", 0) == 0) message = "'" + mesh_path + "': " + message;
+      return report_error(COMMAND, message, exit_code_for(status));
+    }
+  }
+  const std::string job_id = submitted.job().id();
+
+  ProgressPrinter printer(isatty(STDERR_FILENO) == 1);
+  const WatchOutcome outcome = watch_job(**connection, job_id, [&](const v1::JobEvent& event) { printer(event); });
+  if (outcome.interrupted) {
+    grpc::ClientContext context;
+    (*connection)->prepare(context);
+    v1::CancelJobRequest cancel;
+    cancel.set_job_id(job_id);
+    v1::Job job;
+    (*connection)->stub().CancelJob(&context, cancel, &job);
+    return report_error(COMMAND, "interrupted; job " + job_id + " cancelled", EXIT_INTERRUPTED);
+  }
+  if (!outcome.status.ok()) return report_error(COMMAND, outcome.status.error_message(), exit_code_for(outcome.status));
+  if (outcome.state != v1::JOB_STATE_COMPLETED)
+    return report_error(COMMAND, "job " + job_id + " " + state_name(outcome.state) + ": " + outcome.message,
+                        EXIT_JOB_FAILED);
+
+  v1::GetResultRequest result_request;
+  result_request.set_job_id(job_id);
+  result_request.set_format(out_path ? mesh_format_from_path(*out_path) : v1::MESH_FORMAT_OBJ);
+  v1::JobResult result;
+  {
+    grpc::ClientContext context;
+    (*connection)->prepare(context);
+    const grpc::Status status = (*connection)->stub().GetResult(&context, result_request, &result);
+    if (!status.ok()) return report_error(COMMAND, status.error_message(), exit_code_for(status));
+  }
+
+  if (parsed->has("json"))
+    std::cout << result.report_json() << std::endl;
+  else
+    std::cout << summary_from_report(result.report_json()) << std::flush;
+
+  if (!result.converged()) {
+    if (out_path) std::fprintf(stderr, "balloon simulate: not converged; %s not written\n", out_path->c_str());
+    return EXIT_NOT_CONVERGED;
+  }
+  if (out_path) {
+    Result<bool> written = write_file_atomically(*out_path, result.inflated_mesh().data());
+    if (!written) return report_error(COMMAND, "--out: " + written.error(), EXIT_INTERNAL);
+  }
+  return EXIT_OK;
+}
+
+}  // namespace balloon::cli

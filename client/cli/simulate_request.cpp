@@ -1,0 +1,90 @@
+#include "simulate_request.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "jobs/simulate_job.hpp"
+#include "material/material.hpp"
+
+namespace balloon::cli {
+
+std::vector<OptionSpec> simulate_option_specs() {
+  return {{"material"}, {"thickness"}, {"pressure"}, {"volume-ratio"}};
+}
+
+balloon::v1::MeshFormat mesh_format_from_path(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (extension == ".obj") return balloon::v1::MESH_FORMAT_OBJ;
+  if (extension == ".stl") return balloon::v1::MESH_FORMAT_STL;
+  if (extension == ".ply") return balloon::v1::MESH_FORMAT_PLY;
+  if (extension == ".off") return balloon::v1::MESH_FORMAT_OFF;
+  if (extension == ".gltf") return balloon::v1::MESH_FORMAT_GLTF;
+  if (extension == ".glb") return balloon::v1::MESH_FORMAT_GLB;
+  return balloon::v1::MESH_FORMAT_UNSPECIFIED;
+}
+
+Result<balloon::v1::SubmitJobRequest> simulate_request_from_args(const ParsedArgs& args) {
+  if (args.positionals.empty()) return fail("missing REST_MESH (see --help)");
+  if (args.positionals.size() > 1)
+    return fail("expected one REST_MESH, got " + std::to_string(args.positionals.size()) + " paths");
+  const std::string& mesh_path = args.positionals.front();
+
+  balloon::v1::SubmitJobRequest request;
+  balloon::v1::SimulateJob* job = request.mutable_spec()->mutable_simulate();
+
+  const std::optional<std::string> spec = args.get("material");
+  if (!spec) return fail("missing --material SPEC");
+  const Result<Material> material = parse_material_spec(*spec);
+  if (material) {
+    // Presets travel by name (the report then names them); inline specs as given.
+    if (spec->find(':') == std::string::npos)
+      job->mutable_material()->set_name(*spec);
+    else
+      job->mutable_material()->set_spec(*spec);
+  } else if (spec->find(':') == std::string::npos && !spec->empty()) {
+    job->mutable_material()->set_name(*spec);  // perhaps a stored material: the server decides
+  } else {
+    return fail("--material: " + material.error());
+  }
+
+  jobs::SimulateParameters parameters;
+  if (const auto text = args.get("thickness")) {
+    Result<double> value = parse_number("thickness", *text);
+    if (!value) return fail(value.error());
+    parameters.thickness_mm = *value;
+  }
+  if (const auto text = args.get("pressure")) {
+    Result<double> value = parse_number("pressure", *text);
+    if (!value) return fail(value.error());
+    parameters.pressure_kpa = *value;
+  }
+  if (const auto text = args.get("volume-ratio")) {
+    Result<double> value = parse_number("volume-ratio", *text);
+    if (!value) return fail(value.error());
+    parameters.volume_ratio = *value;
+  }
+  if (const std::string problem = jobs::simulate_parameters_problem(parameters); !problem.empty()) return fail(problem);
+  job->set_thickness_mm(parameters.thickness_mm);
+  if (parameters.pressure_kpa) job->set_pressure_kpa(*parameters.pressure_kpa);
+  if (parameters.volume_ratio) job->set_volume_ratio(*parameters.volume_ratio);
+
+  const balloon::v1::MeshFormat format = mesh_format_from_path(mesh_path);
+  std::error_code error;
+  if (!std::filesystem::exists(mesh_path, error)) return fail("cannot read mesh '" + mesh_path + "': no such file");
+  if (format == balloon::v1::MESH_FORMAT_UNSPECIFIED)
+    return fail("cannot read mesh '" + mesh_path + "': unknown extension (obj, stl, ply, off, gltf, glb)");
+  std::ifstream in(mesh_path, std::ios::binary);
+  if (!in) return fail("cannot read mesh '" + mesh_path + "'");
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  job->mutable_rest_mesh()->set_data(bytes.str());
+  job->mutable_rest_mesh()->set_format(format);
+  return request;
+}
+
+}  // namespace balloon::cli

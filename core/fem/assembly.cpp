@@ -1,0 +1,111 @@
+#include "fem/assembly.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace balloon::fem {
+
+TriangleAssembly::TriangleAssembly(const Faces& faces, int vertex_count, const std::vector<bool>& fixed_coordinate) {
+  const int coordinates = 3 * vertex_count;
+  if (static_cast<int>(fixed_coordinate.size()) != coordinates)
+    throw std::invalid_argument("TriangleAssembly: fixed_coordinate must have 3#V entries");
+  m_free_index.assign(static_cast<size_t>(coordinates), -1);
+  for (int c = 0; c < coordinates; ++c) {
+    if (!fixed_coordinate[static_cast<size_t>(c)]) {
+      m_free_index[static_cast<size_t>(c)] = m_free_count++;
+      m_free_to_coordinate.push_back(c);
+    }
+  }
+
+  // Rows of each column: the free coordinates of all vertices sharing a triangle, upper part only.
+  std::vector<std::vector<int>> rows_of_column(static_cast<size_t>(m_free_count));
+  auto corner_coordinate = [&](int face, int k) { return 3 * faces(face, k / 3) + k % 3; };
+  for (int f = 0; f < faces.rows(); ++f) {
+    for (int k = 0; k < 9; ++k) {
+      const int col = m_free_index[static_cast<size_t>(corner_coordinate(f, k))];
+      if (col < 0) continue;
+      for (int l = 0; l < 9; ++l) {
+        const int row = m_free_index[static_cast<size_t>(corner_coordinate(f, l))];
+        if (row >= 0 && row <= col) rows_of_column[static_cast<size_t>(col)].push_back(row);
+      }
+    }
+  }
+  m_column_starts.assign(static_cast<size_t>(m_free_count) + 1, 0);
+  for (int c = 0; c < m_free_count; ++c) {
+    auto& rows = rows_of_column[static_cast<size_t>(c)];
+    rows.push_back(c);  // always keep the diagonal, even for an isolated coordinate
+    std::sort(rows.begin(), rows.end());
+    rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+    m_column_starts[static_cast<size_t>(c) + 1] = m_column_starts[static_cast<size_t>(c)] + static_cast<int>(rows.size());
+  }
+  m_row_indices.reserve(static_cast<size_t>(m_column_starts.back()));
+  for (const auto& rows : rows_of_column) m_row_indices.insert(m_row_indices.end(), rows.begin(), rows.end());
+  m_values.assign(m_row_indices.size(), 0.0);
+
+  auto slot = [&](int row, int col) {
+    const auto begin = m_row_indices.begin() + m_column_starts[static_cast<size_t>(col)];
+    const auto end = m_row_indices.begin() + m_column_starts[static_cast<size_t>(col) + 1];
+    return static_cast<int>(std::lower_bound(begin, end, row) - m_row_indices.begin());
+  };
+  m_diagonal_slots.resize(static_cast<size_t>(m_free_count));
+  for (int c = 0; c < m_free_count; ++c) m_diagonal_slots[static_cast<size_t>(c)] = slot(c, c);
+  m_element_slots.assign(static_cast<size_t>(faces.rows()) * 81, -1);
+  for (int f = 0; f < faces.rows(); ++f) {
+    for (int k = 0; k < 9; ++k) {
+      const int col = m_free_index[static_cast<size_t>(corner_coordinate(f, k))];
+      if (col < 0) continue;
+      for (int l = 0; l < 9; ++l) {
+        const int row = m_free_index[static_cast<size_t>(corner_coordinate(f, l))];
+        if (row >= 0 && row <= col) m_element_slots[static_cast<size_t>(f) * 81 + static_cast<size_t>(l + 9 * k)] = slot(row, col);
+      }
+    }
+  }
+}
+
+void TriangleAssembly::set_zero() { std::fill(m_values.begin(), m_values.end(), 0.0); }
+
+void TriangleAssembly::add(int face, const Matrix9d& block) {
+  const int* slots = &m_element_slots[static_cast<size_t>(face) * 81];
+  const double* entries = block.data();  // column-major: entry (l, k) at l + 9 k
+  for (int i = 0; i < 81; ++i)
+    if (slots[i] >= 0) m_values[static_cast<size_t>(slots[i])] += entries[i];
+}
+
+void TriangleAssembly::add_to_diagonal(double value) {
+  for (int s : m_diagonal_slots) m_values[static_cast<size_t>(s)] += value;
+}
+
+double TriangleAssembly::mean_abs_diagonal() const {
+  if (m_diagonal_slots.empty()) return 0.0;
+  double sum = 0.0;
+  for (int s : m_diagonal_slots) sum += std::abs(m_values[static_cast<size_t>(s)]);
+  return sum / static_cast<double>(m_diagonal_slots.size());
+}
+
+Eigen::VectorXd TriangleAssembly::restrict(const Eigen::VectorXd& full) const {
+  Eigen::VectorXd free(m_free_count);
+  for (int i = 0; i < m_free_count; ++i) free[i] = full[m_free_to_coordinate[static_cast<size_t>(i)]];
+  return free;
+}
+
+Eigen::VectorXd TriangleAssembly::extend(const Eigen::VectorXd& free) const {
+  Eigen::VectorXd full = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(m_free_index.size()));
+  for (int i = 0; i < m_free_count; ++i) full[m_free_to_coordinate[static_cast<size_t>(i)]] = free[i];
+  return full;
+}
+
+Eigen::VectorXd TriangleAssembly::multiply(const Eigen::VectorXd& x) const {
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(m_free_count);
+  for (int col = 0; col < m_free_count; ++col) {
+    for (int s = m_column_starts[static_cast<size_t>(col)]; s < m_column_starts[static_cast<size_t>(col) + 1]; ++s) {
+      const int row = m_row_indices[static_cast<size_t>(s)];
+      const double v = m_values[static_cast<size_t>(s)];
+      y[row] += v * x[col];
+      if (row != col) y[col] += v * x[row];
+    }
+  }
+  return y;
+}
+
+}  // namespace balloon::fem

@@ -1,0 +1,54 @@
+#pragma once
+/// The one path from per-triangle 9x9 blocks into a global sparse matrix. The sparsity pattern of the
+/// free coordinates is built once per mesh, with a precomputed slot for every element entry, so
+/// assembly is a plain scatter with no search.
+#include <Eigen/Core>
+#include <vector>
+
+#include "fem/membrane_element.hpp"
+#include "mesh/tri_mesh.hpp"
+
+namespace balloon::fem {
+
+/// Upper triangle (row <= column) of a symmetric matrix over the free coordinates, in compressed-column
+/// form, plus the slots of every triangle's 9x9 block.
+class TriangleAssembly {
+ public:
+  /// `fixed_coordinate` has 3#V entries (x0, y0, z0, x1, ...); fixed coordinates get no row or column.
+  TriangleAssembly(const Faces& faces, int vertex_count, const std::vector<bool>& fixed_coordinate);
+
+  int free_count() const { return m_free_count; }
+  /// Free index of a coordinate, or -1 when it is fixed.
+  int free_index(int coordinate) const { return m_free_index[static_cast<size_t>(coordinate)]; }
+  const std::vector<int>& column_starts() const { return m_column_starts; }
+  const std::vector<int>& row_indices() const { return m_row_indices; }
+  std::vector<double>& values() { return m_values; }
+  const std::vector<double>& values() const { return m_values; }
+
+  void set_zero();
+  /// Adds a symmetric 9x9 block of triangle `face` (its corners in face order).
+  void add(int face, const Matrix9d& block);
+  /// Adds `value` to the diagonal of every free coordinate.
+  void add_to_diagonal(double value);
+  /// Mean absolute diagonal entry (scale for shifts).
+  double mean_abs_diagonal() const;
+
+  /// Full 3#V vector -> free coordinates.
+  Eigen::VectorXd restrict(const Eigen::VectorXd& full) const;
+  /// Free coordinates -> full 3#V vector with zeros at fixed coordinates.
+  Eigen::VectorXd extend(const Eigen::VectorXd& free) const;
+  /// y = A x for the assembled symmetric matrix (free coordinates).
+  Eigen::VectorXd multiply(const Eigen::VectorXd& x) const;
+
+ private:
+  int m_free_count = 0;
+  std::vector<int> m_free_index;
+  std::vector<int> m_free_to_coordinate;
+  std::vector<int> m_column_starts;
+  std::vector<int> m_row_indices;
+  std::vector<double> m_values;
+  std::vector<int> m_diagonal_slots;
+  std::vector<int> m_element_slots;  // 81 per face, -1 for skipped entries
+};
+
+}  // namespace balloon::fem

@@ -1,0 +1,102 @@
+#include "fem/balloon_model.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "fem/pressure_load.hpp"
+
+namespace balloon::fem {
+
+BalloonModel::BalloonModel(const TriMesh& rest, const Material& material, std::vector<double> element_thickness)
+    : m_faces(rest.faces), m_material(material), m_thickness(std::move(element_thickness)) {
+  if (static_cast<int>(m_thickness.size()) != rest.face_count())
+    throw std::invalid_argument("BalloonModel: one thickness per triangle expected");
+  set_rest_positions(rest.vertices);
+}
+
+void BalloonModel::set_rest_positions(const Positions& rest) {
+  m_rest = rest;
+  m_rest_triangles.resize(static_cast<size_t>(m_faces.rows()));
+  m_rest_area = 0.0;
+  const Eigen::Map<const Eigen::VectorXd> x(m_rest.data(), m_rest.size());
+  for (int f = 0; f < m_faces.rows(); ++f) {
+    m_rest_triangles[static_cast<size_t>(f)] = make_rest_triangle(corners(x, f));
+    m_rest_area += m_rest_triangles[static_cast<size_t>(f)].area;
+  }
+}
+
+Vector9d BalloonModel::corners(const Eigen::VectorXd& x, int face) const {
+  Vector9d c;
+  for (int k = 0; k < 3; ++k) c.segment<3>(3 * k) = x.segment<3>(3 * m_faces(face, k));
+  return c;
+}
+
+double BalloonModel::elastic_energy(const Eigen::VectorXd& x) const {
+  double total = 0.0;
+  for (int f = 0; f < m_faces.rows(); ++f) {
+    total += membrane_energy(m_material, m_thickness[static_cast<size_t>(f)], m_rest_triangles[static_cast<size_t>(f)],
+                             corners(x, f));
+    if (!std::isfinite(total)) return std::numeric_limits<double>::infinity();
+  }
+  return total;
+}
+
+Eigen::VectorXd BalloonModel::elastic_gradient(const Eigen::VectorXd& x) const {
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
+  for (int f = 0; f < m_faces.rows(); ++f) {
+    const Vector9d ge = membrane_gradient(m_material, m_thickness[static_cast<size_t>(f)],
+                                          m_rest_triangles[static_cast<size_t>(f)], corners(x, f));
+    for (int k = 0; k < 3; ++k) g.segment<3>(3 * m_faces(f, k)) += ge.segment<3>(3 * k);
+  }
+  return g;
+}
+
+double BalloonModel::volume(const Eigen::VectorXd& x) const {
+  double v = 0.0;
+  for (int f = 0; f < m_faces.rows(); ++f) v += triangle_signed_volume(corners(x, f));
+  return v;
+}
+
+Eigen::VectorXd BalloonModel::volume_gradient(const Eigen::VectorXd& x) const {
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
+  for (int f = 0; f < m_faces.rows(); ++f) {
+    const Vector9d ge = triangle_volume_gradient(corners(x, f));
+    for (int k = 0; k < 3; ++k) g.segment<3>(3 * m_faces(f, k)) += ge.segment<3>(3 * k);
+  }
+  return g;
+}
+
+double BalloonModel::area(const Eigen::VectorXd& x) const {
+  double a = 0.0;
+  for (int f = 0; f < m_faces.rows(); ++f) {
+    const Vector9d c = corners(x, f);
+    a += 0.5 * (c.segment<3>(3) - c.segment<3>(0)).cross(c.segment<3>(6) - c.segment<3>(0)).norm();
+  }
+  return a;
+}
+
+double BalloonModel::max_stretch(const Eigen::VectorXd& x) const {
+  double largest = 0.0;
+  for (int f = 0; f < m_faces.rows(); ++f)
+    largest = std::max(largest, principal_stretches_squared(m_rest_triangles[static_cast<size_t>(f)], corners(x, f))[1]);
+  return std::sqrt(largest);
+}
+
+void BalloonModel::assemble_hessian(const Eigen::VectorXd& x, double pressure_mpa, TriangleAssembly& assembly,
+                                    bool project_membrane) const {
+  assembly.set_zero();
+  double energy;
+  Vector9d gradient;
+  Matrix9d hessian;
+  for (int f = 0; f < m_faces.rows(); ++f) {
+    const Vector9d c = corners(x, f);
+    membrane_energy_gradient_hessian(m_material, m_thickness[static_cast<size_t>(f)],
+                                     m_rest_triangles[static_cast<size_t>(f)], c, energy, gradient, hessian,
+                                     project_membrane);
+    if (pressure_mpa != 0.0) hessian -= pressure_mpa * triangle_volume_hessian(c);
+    assembly.add(f, hessian);
+  }
+}
+
+}  // namespace balloon::fem

@@ -1,0 +1,60 @@
+#pragma once
+/// Mesh-wide sums of the membrane and pressure terms: the total potential W(x) - p V(x) of a balloon
+/// with a fixed rest shape, its gradient, and its Hessian assembled through TriangleAssembly.
+/// Positions are flat 3#V vectors in mm; pressure p in MPa inside core (kPa only at the user edge).
+#include <Eigen/Core>
+#include <vector>
+
+#include "fem/assembly.hpp"
+#include "fem/membrane_element.hpp"
+#include "material/material.hpp"
+#include "mesh/tri_mesh.hpp"
+
+namespace balloon::fem {
+
+class BalloonModel {
+ public:
+  /// `element_thickness` has one entry per triangle (mm).
+  BalloonModel(const TriMesh& rest, const Material& material, std::vector<double> element_thickness);
+
+  /// Replaces the rest positions (same connectivity); the design optimizer moves them.
+  void set_rest_positions(const Positions& rest);
+
+  const Faces& faces() const { return m_faces; }
+  const Positions& rest_positions() const { return m_rest; }
+  const Material& material() const { return m_material; }
+  int vertex_count() const { return static_cast<int>(m_rest.rows()); }
+  double rest_area() const { return m_rest_area; }
+  double thickness(int face) const { return m_thickness[static_cast<size_t>(face)]; }
+
+  /// Corner positions of triangle `face` as a 9-vector.
+  Vector9d corners(const Eigen::VectorXd& x, int face) const;
+
+  /// Elastic energy W (N*mm); +infinity when a triangle has collapsed.
+  double elastic_energy(const Eigen::VectorXd& x) const;
+  /// dW/dx (3#V, N).
+  Eigen::VectorXd elastic_gradient(const Eigen::VectorXd& x) const;
+  /// Enclosed (signed) volume V (mm^3).
+  double volume(const Eigen::VectorXd& x) const;
+  /// dV/dx (3#V, mm^2): a third of the area-weighted normals at each vertex.
+  Eigen::VectorXd volume_gradient(const Eigen::VectorXd& x) const;
+  /// Surface area (mm^2).
+  double area(const Eigen::VectorXd& x) const;
+  /// Largest principal stretch over all triangles.
+  double max_stretch(const Eigen::VectorXd& x) const;
+
+  /// Assembles the Hessian of W - p V (N/mm) into `assembly` (which is zeroed first).
+  /// `project_membrane` clamps each membrane block to positive semi-definite.
+  void assemble_hessian(const Eigen::VectorXd& x, double pressure_mpa, TriangleAssembly& assembly,
+                        bool project_membrane) const;
+
+ private:
+  Faces m_faces;
+  Positions m_rest;
+  Material m_material;
+  std::vector<double> m_thickness;
+  std::vector<RestTriangle> m_rest_triangles;
+  double m_rest_area = 0.0;
+};
+
+}  // namespace balloon::fem

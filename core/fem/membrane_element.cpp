@@ -1,0 +1,159 @@
+#include "fem/membrane_element.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <limits>
+
+#include "fem/second_order_jet.hpp"
+
+namespace balloon::fem {
+namespace {
+
+struct EdgeGram {
+  Eigen::Vector3d e1, e2;  // x2 - x1, x3 - x1
+  double s11, s12, s22;
+};
+
+EdgeGram edge_gram(const Vector9d& x) {
+  EdgeGram g;
+  g.e1 = x.segment<3>(3) - x.segment<3>(0);
+  g.e2 = x.segment<3>(6) - x.segment<3>(0);
+  g.s11 = g.e1.dot(g.e1);
+  g.s12 = g.e1.dot(g.e2);
+  g.s22 = g.e2.dot(g.e2);
+  return g;
+}
+
+/// d(s11, s12, s22)/d(x1, x2, x3): 3x9.
+Eigen::Matrix<double, 3, 9> gram_jacobian(const EdgeGram& g) {
+  Eigen::Matrix<double, 3, 9> J;
+  J.setZero();
+  J.block<1, 3>(0, 3) = 2.0 * g.e1.transpose();
+  J.block<1, 3>(0, 0) = -2.0 * g.e1.transpose();
+  J.block<1, 3>(1, 3) = g.e2.transpose();
+  J.block<1, 3>(1, 6) = g.e1.transpose();
+  J.block<1, 3>(1, 0) = -(g.e1 + g.e2).transpose();
+  J.block<1, 3>(2, 6) = 2.0 * g.e2.transpose();
+  J.block<1, 3>(2, 0) = -2.0 * g.e2.transpose();
+  return J;
+}
+
+/// W = h * A_rest * Psi(I1, I2) as a function of the Gram entries (eq. 3, 4, 11):
+/// tr C = tr(S M^-1), det C = det S / det M, I1 = tr C + 1/det C, I2 = det C + tr C / det C.
+template <int N>
+Jet<N> gram_energy(const Material& material, double thickness, const Jet<N>& s11, const Jet<N>& s12,
+                   const Jet<N>& s22, const Jet<N>& m11, const Jet<N>& m12, const Jet<N>& m22) {
+  const Jet<N> det_m = m11 * m22 - m12 * m12;
+  const Jet<N> numerator = s11 * m22 - 2.0 * (s12 * m12) + s22 * m11;
+  const Jet<N> trace_c = numerator / det_m;
+  const Jet<N> det_s = s11 * s22 - s12 * s12;
+  const Jet<N> det_c = det_s / det_m;
+  const Jet<N> inv_det_c = inverse(det_c);
+  const Jet<N> I1 = trace_c + inv_det_c;
+  const Jet<N> I2 = det_c + trace_c * inv_det_c;
+  const InvariantDerivatives d = strain_energy(material, I1.v, I2.v);
+  const Jet<N> psi = apply2(I1, I2, d.psi, d.d1, d.d2, d.d11, d.d12, d.d22);
+  const Jet<N> rest_area = 0.5 * sqrt(det_m);
+  return thickness * (rest_area * psi);
+}
+
+bool collapsed(const EdgeGram& g) {
+  const double det_s = g.s11 * g.s22 - g.s12 * g.s12;
+  return !(det_s > 1e-24 * (g.s11 + g.s22) * (g.s11 + g.s22));
+}
+
+template <int N>
+Eigen::Matrix<double, N, N> clamp_eigenvalues(const Eigen::Matrix<double, N, N>& m) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, N, N>> eig(m);
+  const auto values = eig.eigenvalues().cwiseMax(0.0);
+  return eig.eigenvectors() * values.asDiagonal() * eig.eigenvectors().transpose();
+}
+
+}  // namespace
+
+RestTriangle make_rest_triangle(const Vector9d& rest) {
+  const EdgeGram g = edge_gram(rest);
+  RestTriangle t;
+  t.m11 = g.s11;
+  t.m12 = g.s12;
+  t.m22 = g.s22;
+  t.area = 0.5 * std::sqrt(std::max(0.0, g.s11 * g.s22 - g.s12 * g.s12));
+  return t;
+}
+
+double membrane_energy(const Material& material, double thickness, const RestTriangle& rest, const Vector9d& x) {
+  const EdgeGram g = edge_gram(x);
+  if (collapsed(g)) return std::numeric_limits<double>::infinity();
+  const double det_m = rest.m11 * rest.m22 - rest.m12 * rest.m12;
+  const double trace_c = (g.s11 * rest.m22 - 2.0 * g.s12 * rest.m12 + g.s22 * rest.m11) / det_m;
+  const double det_c = (g.s11 * g.s22 - g.s12 * g.s12) / det_m;
+  const double I1 = trace_c + 1.0 / det_c;
+  const double I2 = det_c + trace_c / det_c;
+  return thickness * rest.area * strain_energy(material, I1, I2).psi;
+}
+
+Vector9d membrane_gradient(const Material& material, double thickness, const RestTriangle& rest, const Vector9d& x) {
+  double energy;
+  Vector9d gradient;
+  Matrix9d hessian;
+  membrane_energy_gradient_hessian(material, thickness, rest, x, energy, gradient, hessian);
+  return gradient;
+}
+
+void membrane_energy_gradient_hessian(const Material& material, double thickness, const RestTriangle& rest,
+                                      const Vector9d& x, double& energy, Vector9d& gradient, Matrix9d& hessian,
+                                      bool project_to_psd) {
+  const EdgeGram g = edge_gram(x);
+  if (collapsed(g)) {
+    energy = std::numeric_limits<double>::infinity();
+    gradient.setZero();
+    hessian.setZero();
+    return;
+  }
+  using J3 = Jet<3>;
+  const J3 w = gram_energy<3>(material, thickness, J3::variable(g.s11, 0), J3::variable(g.s12, 1),
+                              J3::variable(g.s22, 2), J3::constant(rest.m11), J3::constant(rest.m12),
+                              J3::constant(rest.m22));
+  const Eigen::Matrix<double, 3, 9> js = gram_jacobian(g);
+  energy = w.v;
+  gradient = js.transpose() * w.g;
+
+  // Material part: Js^T (d2W/ds2) Js. Geometric part: sum_k dW/ds_k * d2 s_k/dx2, which is
+  // D^T (P kron I3) D with D mapping corners to the two edges.
+  Eigen::Matrix3d material_curvature = w.h;
+  Eigen::Matrix2d stress;
+  stress << 2.0 * w.g[0], w.g[1], w.g[1], 2.0 * w.g[2];
+  if (project_to_psd) {
+    material_curvature = clamp_eigenvalues<3>(material_curvature);
+    stress = clamp_eigenvalues<2>(stress);
+  }
+  hessian.noalias() = js.transpose() * material_curvature * js;
+  Eigen::Matrix<double, 2, 3> edges_of_corners;
+  edges_of_corners << -1, 1, 0, -1, 0, 1;
+  const Eigen::Matrix3d corner_coupling = edges_of_corners.transpose() * stress * edges_of_corners;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) hessian.block<3, 3>(3 * a, 3 * b).diagonal().array() += corner_coupling(a, b);
+}
+
+Matrix9d membrane_mixed_derivative(const Material& material, double thickness, const Vector9d& rest,
+                                   const Vector9d& x) {
+  const EdgeGram g = edge_gram(x);
+  const EdgeGram m = edge_gram(rest);
+  using J6 = Jet<6>;
+  const J6 w = gram_energy<6>(material, thickness, J6::variable(g.s11, 0), J6::variable(g.s12, 1),
+                              J6::variable(g.s22, 2), J6::variable(m.s11, 3), J6::variable(m.s12, 4),
+                              J6::variable(m.s22, 5));
+  // gradient_x = Js(x)^T dW/ds(s, m(rest)), so d/d(rest) = Js^T d2W/(ds dm) Jm.
+  return gram_jacobian(g).transpose() * w.h.block<3, 3>(0, 3) * gram_jacobian(m);
+}
+
+Eigen::Vector2d principal_stretches_squared(const RestTriangle& rest, const Vector9d& x) {
+  const EdgeGram g = edge_gram(x);
+  const double det_m = rest.m11 * rest.m22 - rest.m12 * rest.m12;
+  const double trace_c = (g.s11 * rest.m22 - 2.0 * g.s12 * rest.m12 + g.s22 * rest.m11) / det_m;
+  const double det_c = (g.s11 * g.s22 - g.s12 * g.s12) / det_m;
+  const double disc = std::sqrt(std::max(0.0, 0.25 * trace_c * trace_c - det_c));
+  return {0.5 * trace_c - disc, 0.5 * trace_c + disc};
+}
+
+}  // namespace balloon::fem

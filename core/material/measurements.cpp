@@ -1,0 +1,207 @@
+#include "material/measurements.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <functional>
+#include <sstream>
+
+namespace balloon {
+namespace {
+
+// A drop of the stress below an earlier row larger than this fraction of the table's stress range is
+// treated as a broken table rather than digitising noise (the published tables drop by < 1%).
+constexpr double STRESS_DROP_TOLERANCE = 0.10;
+
+std::string trim(const std::string& s) {
+  const auto begin = s.find_first_not_of(" \t\r");
+  if (begin == std::string::npos) return "";
+  const auto end = s.find_last_not_of(" \t\r");
+  return s.substr(begin, end - begin + 1);
+}
+
+std::string lower(std::string s) {
+  for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::vector<std::string> split_cells(const std::string& line) {
+  std::vector<std::string> cells;
+  std::stringstream stream(line);
+  std::string cell;
+  while (std::getline(stream, cell, ',')) cells.push_back(trim(cell));
+  if (!line.empty() && line.back() == ',') cells.push_back("");
+  return cells;
+}
+
+std::string number_text(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+bool is_stress_table(TestKind kind) { return kind != TestKind::Bulge; }
+
+std::string expected_header(TestKind kind) {
+  return is_stress_table(kind) ? "stretch,nominal_stress_MPa" : "pressure_kpa,extension_ratio[,apex_height_mm]";
+}
+
+/// Checks the rules documented at parse_measurements; `where(i)` names row i ("line 7" or "point 3").
+std::string validate(const MeasurementSet& set, const std::function<std::string(size_t)>& where) {
+  const size_t n = set.x.size();
+  if (set.y.size() != n) return "the data has " + std::to_string(n) + " x values but " + std::to_string(set.y.size()) + " y values";
+  if (!set.apex_height_mm.empty() && set.apex_height_mm.size() != n)
+    return "the data has " + std::to_string(n) + " points but " + std::to_string(set.apex_height_mm.size()) + " apex heights";
+  const std::string x_name = is_stress_table(set.kind) ? "stretch" : "extension ratio";
+  const std::string y_name = is_stress_table(set.kind) ? "nominal stress" : "pressure";
+  for (size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(set.x[i]) || !std::isfinite(set.y[i])) return where(i) + ": values must be finite numbers";
+    if (is_stress_table(set.kind)) {
+      if (set.x[i] < 1.0) return where(i) + ": stretch " + number_text(set.x[i]) + " < 1 (compression is not fitted)";
+      if (set.y[i] < 0.0)
+        return where(i) + ": negative nominal stress " + number_text(set.y[i]) + " MPa at stretch " + number_text(set.x[i]) +
+               " >= 1 (tension)";
+    } else {
+      if (set.y[i] < 0.0) return where(i) + ": negative pressure " + number_text(set.y[i]) + " kPa";
+      if (set.x[i] < 1.0)
+        return where(i) + ": extension ratio " + number_text(set.x[i]) + " < 1 (an inflated disc only grows in area)";
+      if (!set.apex_height_mm.empty() && !(set.apex_height_mm[i] >= 0.0 && std::isfinite(set.apex_height_mm[i])))
+        return where(i) + ": apex height must be a finite number >= 0 mm";
+    }
+    if (i > 0 && !(set.x[i] > set.x[i - 1]))
+      return where(i) + ": " + x_name + " " + number_text(set.x[i]) + " is not larger than the previous row's " +
+             number_text(set.x[i - 1]) + " (rows must be in loading order, " + x_name + " strictly increasing)";
+  }
+  if (n < 2)
+    return n == 0 ? "no data rows" : "only 1 data point (at least 2 are needed to fit a curve)";
+  if (is_stress_table(set.kind)) {
+    const auto [lo, hi] = std::minmax_element(set.y.begin(), set.y.end());
+    const double range = *hi - *lo;
+    double running_max = set.y[0];
+    for (size_t i = 1; i < n; ++i) {
+      if (set.y[i] < running_max - STRESS_DROP_TOLERANCE * range)
+        return where(i) + ": nominal stress " + number_text(set.y[i]) + " MPa falls far below an earlier row's " +
+               number_text(running_max) + " MPa although the stretch grew (stress must rise with stretch)";
+      running_max = std::max(running_max, set.y[i]);
+    }
+  } else {
+    if (!(set.y.back() > set.y.front()))
+      return "pressure " + number_text(set.y.back()) + " kPa at the largest extension ratio is not above the pressure " +
+             number_text(set.y.front()) + " kPa at the smallest: the extension ratio must grow with pressure overall";
+  }
+  return "";
+}
+
+}  // namespace
+
+std::string test_kind_name(TestKind kind) {
+  switch (kind) {
+    case TestKind::Bulge: return "bulge";
+    case TestKind::Uniaxial: return "uniaxial";
+    case TestKind::Equibiaxial: return "equibiaxial";
+    case TestKind::PureShear: return "pure-shear";
+  }
+  return "unknown";
+}
+
+Result<TestKind> parse_test_kind(const std::string& name) {
+  for (auto kind : {TestKind::Bulge, TestKind::Uniaxial, TestKind::Equibiaxial, TestKind::PureShear})
+    if (lower(trim(name)) == test_kind_name(kind)) return kind;
+  return fail("unknown test '" + name + "' (known: bulge, uniaxial, equibiaxial, pure-shear)");
+}
+
+Result<MeasurementSet> parse_measurements(const std::string& csv_text, TestKind kind, const std::string& label) {
+  MeasurementSet set;
+  set.kind = kind;
+  set.label = label;
+  if (csv_text.find_first_not_of(" \t\r\n") == std::string::npos) return fail("no data: the text is empty");
+
+  // Column roles: 0 = x, 1 = y, 2 = apex height.
+  const bool stress = is_stress_table(kind);
+  const std::vector<std::string> names = stress ? std::vector<std::string>{"stretch", "nominal_stress_mpa"}
+                                                : std::vector<std::string>{"extension_ratio", "pressure_kpa", "apex_height_mm"};
+  std::vector<int> role_of_column;
+  std::vector<int> line_of_row;
+  std::stringstream stream(csv_text);
+  std::string raw;
+  int line_number = 0;
+  bool have_header = false;
+  while (std::getline(stream, raw)) {
+    ++line_number;
+    const std::string line = trim(raw);
+    if (line.empty() || line[0] == '#') continue;
+    const auto cells = split_cells(line);
+    const std::string at_line = "line " + std::to_string(line_number);
+    if (!have_header) {
+      have_header = true;
+      std::vector<bool> seen(names.size(), false);
+      // A header of the other family is the likely mistake of passing the wrong --test: say so.
+      std::string hint;
+      if (stress && lower(line).find("pressure_kpa") != std::string::npos) hint = "; this looks like bulge data (use the bulge test)";
+      if (!stress && lower(line).find("stretch") != std::string::npos)
+        hint = "; this looks like a stress-stretch table (use uniaxial, equibiaxial or pure-shear)";
+      for (size_t c = 0; c < cells.size(); ++c) {
+        const std::string name = lower(cells[c]);
+        const auto it = std::find(names.begin(), names.end(), name);
+        if (it == names.end())
+          return fail(at_line + ", column " + std::to_string(c + 1) + ": unknown column '" + cells[c] + "' (expected header '" +
+                      expected_header(kind) + "' for " + test_kind_name(kind) + " data" + hint + ")");
+        const int role = static_cast<int>(it - names.begin());
+        if (seen[role]) return fail(at_line + ", column " + std::to_string(c + 1) + ": column '" + cells[c] + "' appears twice");
+        seen[role] = true;
+        role_of_column.push_back(role);
+      }
+      for (int role = 0; role < 2; ++role) {
+        if (!seen[role]) {
+          return fail(at_line + ": header has no column '" + (stress ? std::string(role == 0 ? "stretch" : "nominal_stress_MPa") : names[role]) +
+                      "' (expected header '" + expected_header(kind) + "' for " + test_kind_name(kind) + " data" + hint + ")");
+        }
+      }
+      continue;
+    }
+    if (cells.size() != role_of_column.size())
+      return fail(at_line + ": expected " + std::to_string(role_of_column.size()) + " cells, found " + std::to_string(cells.size()));
+    double values[3] = {0.0, 0.0, 0.0};
+    for (size_t c = 0; c < cells.size(); ++c) {
+      const std::string at_cell = at_line + ", column " + std::to_string(c + 1);
+      const std::string& text = cells[c];
+      if (text.empty()) return fail(at_cell + ": empty cell");
+      char* end = nullptr;
+      const double value = std::strtod(text.c_str(), &end);
+      if (end == text.c_str() || *end != '\0') return fail(at_cell + ": '" + text + "' is not a number");
+      if (!std::isfinite(value)) return fail(at_cell + ": '" + text + "' is not a finite number");
+      values[role_of_column[c]] = value;
+    }
+    if (stress && values[0] <= 0.0) return fail(at_line + ", column 1: stretch " + number_text(values[0]) + " must be positive");
+    if (stress && values[0] < 1.0) {
+      ++set.dropped_compression_points;  // compression branch: membranes are fitted on tension only
+      continue;
+    }
+    set.x.push_back(values[0]);
+    set.y.push_back(values[1]);
+    if (!stress && role_of_column.size() == 3) set.apex_height_mm.push_back(values[2]);
+    line_of_row.push_back(line_number);
+  }
+  if (!have_header) return fail("no header row: the text has only comments (expected header '" + expected_header(kind) + "')");
+  if (set.x.empty()) {
+    if (set.dropped_compression_points > 0)
+      return fail("no data rows with stretch >= 1 (" + std::to_string(set.dropped_compression_points) + " compression rows dropped)");
+    return fail("no data rows after the header");
+  }
+  const auto where = [&](size_t i) { return "line " + std::to_string(line_of_row[i]); };
+  if (auto problem = validate(set, where); !problem.empty()) return fail(problem);
+  return set;
+}
+
+std::string measurement_problem(const MeasurementSet& set) {
+  const auto where = [](size_t i) { return "point " + std::to_string(i + 1); };
+  if (auto problem = validate(set, where); !problem.empty()) return problem;
+  if (set.kind == TestKind::Bulge) {
+    if (!(set.disc_radius_mm > 0.0 && std::isfinite(set.disc_radius_mm))) return "bulge data needs a disc radius > 0 mm";
+    if (!(set.thickness_mm > 0.0 && std::isfinite(set.thickness_mm))) return "bulge data needs a disc thickness > 0 mm";
+  }
+  return "";
+}
+
+}  // namespace balloon

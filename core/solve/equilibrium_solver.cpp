@@ -1,0 +1,294 @@
+#include "solve/equilibrium_solver.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cmath>
+#include <limits>
+
+namespace balloon {
+namespace {
+
+double now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+bool should_stop(const NewtonSettings& settings, NewtonReport& report) {
+  if (settings.cancel && settings.cancel->cancelled()) {
+    report.message = "cancelled";
+    return true;
+  }
+  if (settings.deadline_s > 0.0 && now_s() > settings.deadline_s) {
+    report.message = "time limit reached";
+    return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+EquilibriumSolver::EquilibriumSolver(fem::BalloonModel& model, const std::vector<bool>& fixed_coordinate)
+    : m_model(model), m_assembly(model.faces(), model.vertex_count(), fixed_coordinate) {
+  m_solver.set_pattern(m_assembly.free_count(), m_assembly.column_starts(), m_assembly.row_indices());
+}
+
+Eigen::VectorXd EquilibriumSolver::residual(const Eigen::VectorXd& x, double pressure_mpa) const {
+  Eigen::VectorXd r = m_model.elastic_gradient(x) - pressure_mpa * m_model.volume_gradient(x);
+  for (int c = 0; c < r.size(); ++c)
+    if (m_assembly.free_index(c) < 0) r[c] = 0.0;
+  return r;
+}
+
+double EquilibriumSolver::force_scale(const Eigen::VectorXd& x, double pressure_mpa) const {
+  Eigen::VectorXd v = m_model.volume_gradient(x);
+  for (int c = 0; c < v.size(); ++c)
+    if (m_assembly.free_index(c) < 0) v[c] = 0.0;
+  double mean_thickness = 0.0;
+  for (int f = 0; f < m_model.faces().rows(); ++f) mean_thickness += m_model.thickness(f);
+  mean_thickness /= std::max<Eigen::Index>(1, m_model.faces().rows());
+  // Floor: a thousandth of the membrane force a unit strain would cause over the surface.
+  const double floor = 1e-3 * m_model.material().shear_modulus() * mean_thickness * std::sqrt(m_model.rest_area());
+  return std::abs(pressure_mpa) * v.norm() + floor;
+}
+
+bool EquilibriumSolver::factorize_stiffness(const Eigen::VectorXd& x, double pressure_mpa, bool allow_one_negative,
+                                            const Eigen::VectorXd* constraint_gradient, bool& exact) {
+  m_model.assemble_hessian(x, pressure_mpa, m_assembly, false);
+  exact = true;
+  if (!m_prefer_ldlt || !allow_one_negative) {
+    if (m_solver.factorize_llt(m_assembly.values()) == SparseSolver::Status::Ok) {
+      m_prefer_ldlt = false;
+      return true;
+    }
+  }
+  if (allow_one_negative && constraint_gradient) {
+    // Past a pressure maximum K has one negative eigenvalue along the inflation mode; the volume
+    // constraint removes it when v^T K^-1 v < 0 (the bordered KKT matrix then has the right inertia).
+    if (m_solver.factorize_ldlt(m_assembly.values()) == SparseSolver::Status::Ok) {
+      const int negative = m_solver.negative_pivots();
+      if (negative == 0) return true;
+      if (negative == 1) {
+        const Eigen::VectorXd b = m_solver.solve(*constraint_gradient);
+        if (constraint_gradient->dot(b) < 0.0) {
+          m_prefer_ldlt = true;
+          return true;
+        }
+      }
+    }
+    m_prefer_ldlt = false;
+  }
+  // Not a stable configuration: shift until positive definite (a damped, inexact Newton step).
+  exact = false;
+  const double base = std::max(1e-30, m_assembly.mean_abs_diagonal());
+  for (double shift = 1e-6 * base; shift < 1e6 * base; shift *= 10.0) {
+    if (m_solver.factorize_llt(m_assembly.values(), shift) == SparseSolver::Status::Ok) return true;
+  }
+  return false;
+}
+
+bool EquilibriumSolver::factorize_at(const Eigen::VectorXd& x, double pressure_mpa) {
+  m_model.assemble_hessian(x, pressure_mpa, m_assembly, false);
+  return m_solver.factorize_llt(m_assembly.values()) == SparseSolver::Status::Ok;
+}
+
+Eigen::VectorXd EquilibriumSolver::solve_with_factorization(const Eigen::VectorXd& b) const {
+  return m_assembly.extend(m_solver.solve(m_assembly.restrict(b)));
+}
+
+NewtonReport EquilibriumSolver::solve_pressure(Eigen::VectorXd& x, double pressure_mpa, const NewtonSettings& settings) {
+  NewtonReport report;
+  auto total_energy = [&](const Eigen::VectorXd& y) { return m_model.elastic_energy(y) - pressure_mpa * m_model.volume(y); };
+  for (report.iterations = 0;; ++report.iterations) {
+    const Eigen::VectorXd r = m_assembly.restrict(residual(x, pressure_mpa));
+    report.residual_norm = r.norm();
+    const double tolerance = settings.relative_tolerance * force_scale(x, pressure_mpa);
+    if (!std::isfinite(report.residual_norm)) {
+      report.message = "non-finite residual";
+      return report;
+    }
+    if (report.residual_norm <= tolerance) {
+      report.converged = true;
+      report.message = "converged";
+      return report;
+    }
+    if (report.iterations >= settings.max_iterations) {
+      report.message = "Newton iteration limit reached";
+      return report;
+    }
+    if (should_stop(settings, report)) return report;
+    bool exact = true;
+    if (!factorize_stiffness(x, pressure_mpa, false, nullptr, exact)) {
+      report.message = "stiffness matrix could not be factorized";
+      return report;
+    }
+    Eigen::VectorXd direction = -m_solver.solve(r);
+    double slope = r.dot(direction);
+    if (!(slope < 0.0)) {
+      direction = -r;
+      slope = -r.squaredNorm();
+    }
+    const Eigen::VectorXd step = m_assembly.extend(direction);
+    const double energy = total_energy(x);
+    double t = 1.0;
+    bool accepted = false;
+    for (int k = 0; k < 40; ++k, t *= 0.5) {
+      const Eigen::VectorXd trial = x + t * step;
+      const double trial_energy = total_energy(trial);
+      if (!std::isfinite(trial_energy)) continue;
+      // Energy decrease (Armijo), or a clear residual decrease where energy differences drown in round-off.
+      if (trial_energy <= energy + 1e-4 * t * slope ||
+          m_assembly.restrict(residual(trial, pressure_mpa)).norm() < 0.5 * report.residual_norm) {
+        x = trial;
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) {
+      report.message = "line search failed";
+      return report;
+    }
+  }
+}
+
+NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
+                                             const NewtonSettings& settings) {
+  NewtonReport report;
+  const double volume_tolerance = settings.relative_tolerance * std::abs(target_volume);
+  auto merit = [&](const Eigen::VectorXd& y, double p, double force_tolerance) {
+    const double rn = m_assembly.restrict(residual(y, p)).norm();
+    const double c = m_model.volume(y) - target_volume;
+    const double value = std::pow(rn / force_tolerance, 2) + std::pow(c / volume_tolerance, 2);
+    return std::isfinite(value) ? value : std::numeric_limits<double>::infinity();
+  };
+  for (report.iterations = 0;; ++report.iterations) {
+    const Eigen::VectorXd r = m_assembly.restrict(residual(x, pressure_mpa));
+    const double c = m_model.volume(x) - target_volume;
+    report.residual_norm = r.norm();
+    report.volume_error = c;
+    const double force_tolerance = settings.relative_tolerance * force_scale(x, pressure_mpa);
+    if (!std::isfinite(report.residual_norm) || !std::isfinite(c)) {
+      report.message = "non-finite residual";
+      return report;
+    }
+    if (report.residual_norm <= force_tolerance && std::abs(c) <= volume_tolerance) {
+      report.converged = true;
+      report.message = "converged";
+      return report;
+    }
+    if (report.iterations >= settings.max_iterations) {
+      report.message = "Newton iteration limit reached";
+      return report;
+    }
+    if (should_stop(settings, report)) return report;
+    const Eigen::VectorXd v = m_assembly.restrict(m_model.volume_gradient(x));
+
+    // Fast path: exact Newton on the KKT system when the stiffness has the inertia of a stable
+    // volume-controlled state; globalised on the residual norm, for which it is a descent direction.
+    bool exact = false;
+    static const bool debug = std::getenv("BALLOON_DEBUG_NEWTON") != nullptr;
+    if (debug)
+      std::fprintf(stderr, "vol it %d r=%.3g tol=%.3g c=%.3g p=%.5g neg=%d skip=%d fails=%d\n", report.iterations,
+                   report.residual_norm, force_tolerance, c, pressure_mpa, m_solver.negative_pivots(), m_skip_ldlt,
+                   m_exact_fails_left);
+    if (m_exact_fails_left == 0 && factorize_exact_for_volume(x, pressure_mpa, v)) {
+      const Eigen::VectorXd a = -m_solver.solve(r);
+      const Eigen::VectorXd b = m_solver.solve(v);
+      const double vb = v.dot(b);
+      if (std::abs(vb) > 0.0) {
+        const double dp = (-c - v.dot(a)) / vb;
+        const Eigen::VectorXd step = m_assembly.extend(a + dp * b);
+        const double merit0 = merit(x, pressure_mpa, force_tolerance);
+        double t = 1.0;
+        for (int k = 0; k < 8 && !exact; ++k, t *= 0.5) {
+          const Eigen::VectorXd trial = x + t * step;
+          if (merit(trial, pressure_mpa + t * dp, force_tolerance) <= (1.0 - 1e-4 * t) * merit0) {
+            x = trial;
+            pressure_mpa += t * dp;
+            exact = true;
+          }
+        }
+      }
+      if (!exact) m_exact_fails_left = 2;
+    } else if (m_exact_fails_left > 0) {
+      --m_exact_fails_left;
+    }
+    if (exact) continue;
+
+    // Robust path (wrinkling, local snap-through, past limit points): one step of the augmented
+    // Lagrangian L = W - p (V - Vt) + kappa/2 (V - Vt)^2 at fixed p, with a positive definite model of
+    // its Hessian (projected membrane blocks, a shift if needed, plus kappa v v^T by Sherman-Morrison),
+    // Armijo line search on L, then the multiplier update p <- p - kappa (V - Vt).
+    if (!augmented_lagrangian_step(x, pressure_mpa, target_volume, v)) {
+      report.message = "line search failed";
+      return report;
+    }
+  }
+}
+
+bool EquilibriumSolver::factorize_exact_for_volume(const Eigen::VectorXd& x, double pressure_mpa,
+                                                   const Eigen::VectorXd& v) {
+  m_model.assemble_hessian(x, pressure_mpa, m_assembly, false);
+  if (m_solver.factorize_llt(m_assembly.values()) == SparseSolver::Status::Ok) {
+    m_last_unstable_modes = 0;
+    return true;
+  }
+  if (m_skip_ldlt > 0) {
+    --m_skip_ldlt;
+    return false;
+  }
+  if (m_solver.factorize_ldlt(m_assembly.values()) != SparseSolver::Status::Ok) {
+    m_skip_ldlt = 2;
+    return false;
+  }
+  // With one negative pivot and v^T K^-1 v < 0 the bordered KKT matrix has the inertia of a stable
+  // volume-controlled state. Otherwise the state is a saddle under volume control (a wrinkling or
+  // symmetry-breaking mode); Newton still converges to it when started close, and the caller's
+  // residual line search decides whether the step is any good.
+  m_last_unstable_modes = m_solver.negative_pivots();
+  if (m_last_unstable_modes == 1 && v.dot(m_solver.solve(v)) < 0.0) m_last_unstable_modes = 0;
+  return true;
+}
+
+bool EquilibriumSolver::augmented_lagrangian_step(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
+                                                  const Eigen::VectorXd& v) {
+  const double c = m_model.volume(x) - target_volume;
+  m_model.assemble_hessian(x, pressure_mpa, m_assembly, true);
+  // Penalty: kappa |v|^2 is ten times a typical diagonal stiffness, so the volume is held firmly even
+  // where the stiffness along v is nearly zero or negative (at and past a pressure maximum).
+  const double kappa = 10.0 * m_assembly.mean_abs_diagonal() / v.squaredNorm();
+  auto lagrangian = [&](const Eigen::VectorXd& y) {
+    const double cy = m_model.volume(y) - target_volume;
+    return m_model.elastic_energy(y) - pressure_mpa * cy + 0.5 * kappa * cy * cy;
+  };
+  const Eigen::VectorXd g =
+      m_assembly.restrict(residual(x, pressure_mpa)) + kappa * c * v;  // grad_x L (free coordinates)
+  const double base = std::max(1e-30, m_assembly.mean_abs_diagonal());
+  bool factorized = m_solver.factorize_llt(m_assembly.values()) == SparseSolver::Status::Ok;
+  for (double shift = 1e-4 * base; !factorized && shift < 1e8 * base; shift *= 100.0)
+    factorized = m_solver.factorize_llt(m_assembly.values(), shift) == SparseSolver::Status::Ok;
+  if (!factorized) return false;
+  // (S + kappa v v^T)^-1 g by Sherman-Morrison.
+  const Eigen::VectorXd sg = m_solver.solve(g);
+  const Eigen::VectorXd sv = m_solver.solve(v);
+  const Eigen::VectorXd direction = -(sg - sv * (kappa * v.dot(sg) / (1.0 + kappa * v.dot(sv))));
+  double slope = g.dot(direction);
+  Eigen::VectorXd step = m_assembly.extend(direction);
+  if (!(slope < 0.0)) {
+    step = -m_assembly.extend(g);
+    slope = -g.squaredNorm();
+  }
+  const double value = lagrangian(x);
+  double t = 1.0;
+  for (int k = 0; k < 40; ++k, t *= 0.5) {
+    const Eigen::VectorXd trial = x + t * step;
+    const double trial_value = lagrangian(trial);
+    if (std::isfinite(trial_value) && trial_value <= value + 1e-4 * t * slope) {
+      x = trial;
+      pressure_mpa -= kappa * (m_model.volume(x) - target_volume);
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace balloon

@@ -1,0 +1,80 @@
+#pragma once
+/// Newton's method for the static equilibrium of a pressurised membrane, under pressure control
+/// (minimise W(x) - p V(x)) or volume control (V(x) = V_target with p as the Lagrange multiplier,
+/// which passes pressure maxima). A stateful object: the sparsity pattern and CHOLMOD's symbolic
+/// analysis are built once and reused by every Newton step, load step and design iteration.
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fem/assembly.hpp"
+#include "fem/balloon_model.hpp"
+#include "progress.hpp"
+#include "solve/sparse_solver.hpp"
+
+namespace balloon {
+
+/// Outcome of one Newton solve.
+struct NewtonReport {
+  bool converged = false;
+  std::string message;
+  int iterations = 0;
+  double residual_norm = 0.0;  ///< |grad W - p grad V| over the free coordinates (N)
+  double volume_error = 0.0;   ///< V - V_target (mm^3), volume control only
+};
+
+struct NewtonSettings {
+  double relative_tolerance = 1e-8;  ///< |r| <= tol * (p |grad V| + force floor)
+  int max_iterations = 30;
+  const CancelToken* cancel = nullptr;
+  double deadline_s = 0.0;  ///< absolute time (steady clock seconds) after which to stop; 0 = none
+};
+
+class EquilibriumSolver {
+ public:
+  /// `fixed_coordinate` (3#V) marks coordinates held at their current values.
+  EquilibriumSolver(fem::BalloonModel& model, const std::vector<bool>& fixed_coordinate);
+
+  fem::BalloonModel& model() { return m_model; }
+  const fem::TriangleAssembly& assembly() const { return m_assembly; }
+
+  /// Newton on W - p V at fixed pressure (MPa), from `x` (3#V, updated in place).
+  NewtonReport solve_pressure(Eigen::VectorXd& x, double pressure_mpa, const NewtonSettings& settings);
+  /// Newton on the KKT system of volume control, from (x, p) (updated in place).
+  NewtonReport solve_volume(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
+                            const NewtonSettings& settings);
+
+  /// Residual r = grad W - p grad V over all coordinates (N), zero at fixed coordinates.
+  Eigen::VectorXd residual(const Eigen::VectorXd& x, double pressure_mpa) const;
+  /// Force scale (N) against which residuals are judged.
+  double force_scale(const Eigen::VectorXd& x, double pressure_mpa) const;
+
+  /// Factorizes the exact Hessian of W - p V at x (free coordinates). True if it is positive definite.
+  bool factorize_at(const Eigen::VectorXd& x, double pressure_mpa);
+  /// Solves K y = b with the last factorization; b and y are full 3#V vectors (fixed entries ignored / zero).
+  Eigen::VectorXd solve_with_factorization(const Eigen::VectorXd& b) const;
+
+  int factorizations() const { return m_solver.factorizations(); }
+
+ private:
+  /// Factorizes K + shift I, escalating the shift until acceptable. Returns false if impossible.
+  bool factorize_stiffness(const Eigen::VectorXd& x, double pressure_mpa, bool allow_one_negative,
+                           const Eigen::VectorXd* constraint_gradient, bool& exact);
+
+  /// Exact stiffness for the volume-controlled KKT step, accepted when its inertia is right.
+  bool factorize_exact_for_volume(const Eigen::VectorXd& x, double pressure_mpa, const Eigen::VectorXd& v);
+  /// One robust augmented-Lagrangian step for volume control (see solve_volume).
+  bool augmented_lagrangian_step(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
+                                 const Eigen::VectorXd& v);
+
+  fem::BalloonModel& m_model;
+  fem::TriangleAssembly m_assembly;
+  SparseSolver m_solver;
+  bool m_prefer_ldlt = false;
+  int m_skip_ldlt = 0;
+  int m_exact_fails_left = 0;
+  int m_last_unstable_modes = 0;
+};
+
+}  // namespace balloon

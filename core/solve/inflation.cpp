@@ -1,0 +1,318 @@
+#include "solve/inflation.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "fem/balloon_model.hpp"
+#include "solve/equilibrium_solver.hpp"
+#include "solve/rigid_modes.hpp"
+
+namespace balloon {
+namespace {
+
+constexpr double MPA_PER_KPA = 1e-3;
+
+double now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+std::string format_kpa(double mpa) {
+  std::ostringstream out;
+  out.precision(4);
+  out << mpa / MPA_PER_KPA << " kPa";
+  return out.str();
+}
+
+/// The continuation state of an inflation: positions, pressure and the volume they satisfy.
+struct PathPoint {
+  Eigen::VectorXd x;
+  double pressure = 0.0;
+  double volume = 0.0;
+};
+
+class InflationRun {
+ public:
+  InflationRun(const TriMesh& rest, const InflationOptions& options)
+      : m_rest(rest),
+        m_options(options),
+        m_model(rest, options.material, thicknesses(rest, options)),
+        m_fixed(fixed_coordinates(rest, options)),
+        m_solver(m_model, m_fixed),
+        m_start(now_s()) {
+    m_settings.relative_tolerance = options.residual_tolerance;
+    m_settings.max_iterations = 60;
+    m_settings.cancel = options.cancel;
+    m_settings.deadline_s = options.max_time_s > 0 ? m_start + options.max_time_s : 0.0;
+  }
+
+  InflationResult run(const Positions* initial_guess) {
+    InflationResult result;
+    const Eigen::Map<const Eigen::VectorXd> rest_flat(m_rest.vertices.data(), m_rest.vertices.size());
+    result.rest_volume_mm3 = m_model.volume(rest_flat);
+    PathPoint state{rest_flat, 0.0, result.rest_volume_mm3};
+    bool ok = true;
+    if (!(result.rest_volume_mm3 > 0.0)) {
+      ok = false;
+      result.message = "the rest mesh encloses no positive volume (open, flat or oriented inwards)";
+    } else {
+      if (initial_guess) {
+        state.x = Eigen::Map<const Eigen::VectorXd>(initial_guess->data(), initial_guess->size());
+        state.volume = m_model.volume(state.x);
+        state.pressure = estimate_pressure(state.x);
+      }
+      if (m_options.control == InflationControl::VolumeRatio)
+        ok = inflate_to_volume(state, m_options.volume_ratio * result.rest_volume_mm3, result.message);
+      else
+        ok = inflate_to_pressure(state, m_options.pressure_kpa * MPA_PER_KPA, result.message);
+    }
+    result.converged = ok;
+    if (ok) result.message = "converged";
+    fill(result, state);
+    return result;
+  }
+
+ private:
+  static std::vector<double> thicknesses(const TriMesh& rest, const InflationOptions& options) {
+    if (!options.element_thickness_mm.empty()) return options.element_thickness_mm;
+    return std::vector<double>(static_cast<size_t>(rest.face_count()), options.thickness_mm);
+  }
+
+  static std::vector<bool> fixed_coordinates(const TriMesh& rest, const InflationOptions& options) {
+    std::vector<bool> fixed(static_cast<size_t>(3 * rest.vertex_count()), false);
+    if (options.fixed_vertices.empty()) {
+      for (int c : rigid_support_coordinates(rest.vertices)) fixed[static_cast<size_t>(c)] = true;
+    } else {
+      for (int v : options.fixed_vertices)
+        for (int a = 0; a < 3; ++a) fixed[static_cast<size_t>(3 * v + a)] = true;
+    }
+    return fixed;
+  }
+
+  bool has_user_fixed_vertices() const { return !m_options.fixed_vertices.empty(); }
+
+  /// Least-squares pressure for a shape: the p minimising |grad W - p grad V|.
+  double estimate_pressure(const Eigen::VectorXd& x) const {
+    const auto& assembly = m_solver.assembly();
+    const Eigen::VectorXd g = assembly.restrict(m_model.elastic_gradient(x));
+    const Eigen::VectorXd v = assembly.restrict(m_model.volume_gradient(x));
+    const double vv = v.squaredNorm();
+    return vv > 0 ? g.dot(v) / vv : 0.0;
+  }
+
+  /// First guess at a new volume: scaled about the centroid for a free balloon (exact for a sphere),
+  /// pushed along the vertex normals when vertices are held.
+  Eigen::VectorXd predict(const Eigen::VectorXd& x, double target_volume) const {
+    Eigen::VectorXd y = x;
+    const double volume = m_model.volume(x);
+    if (!has_user_fixed_vertices() && volume > 0) {
+      const double s = std::cbrt(target_volume / volume);
+      const Positions p = unflatten(x);
+      const Eigen::RowVector3d center = p.colwise().mean();
+      Positions scaled = (p.rowwise() - center) * s;
+      scaled.rowwise() += center;
+      return flat(scaled);
+    }
+    for (int pass = 0; pass < 3; ++pass) {
+      Eigen::VectorXd v = m_model.volume_gradient(y);
+      for (int c = 0; c < v.size(); ++c)
+        if (m_fixed[static_cast<size_t>(c)]) v[c] = 0.0;
+      const double vv = v.squaredNorm();
+      if (!(vv > 0)) break;
+      y += (target_volume - m_model.volume(y)) / vv * v;
+    }
+    return y;
+  }
+
+  void report_progress(const PathPoint& state, double residual, bool with_shape) {
+    if (!m_options.progress) return;
+    ProgressEvent event;
+    event.phase = "inflate";
+    event.iteration = m_load_steps;
+    event.elapsed_s = now_s() - m_start;
+    event.residual_norm = residual;
+    event.pressure_kpa = state.pressure / MPA_PER_KPA;
+    Positions shape;
+    if (with_shape) {
+      shape = unflatten(state.x);
+      event.shape = &shape;
+    }
+    m_options.progress(event);
+  }
+
+  /// One volume step with the predictor; updates `state` on success.
+  bool volume_step(PathPoint& state, double target_volume, NewtonReport& report) {
+    Eigen::VectorXd x = predict(state.x, target_volume);
+    double pressure = state.pressure;
+    if (pressure == 0.0) pressure = estimate_pressure(x);
+    report = m_solver.solve_volume(x, pressure, target_volume, m_settings);
+    m_newton_iterations += report.iterations;
+    if (!report.converged) return false;
+    state = {x, pressure, target_volume};
+    ++m_load_steps;
+    m_residual = report.residual_norm;
+    report_progress(state, report.residual_norm, true);
+    return true;
+  }
+
+  bool stopped(const NewtonReport& report) const {
+    return report.message == "cancelled" || report.message == "time limit reached";
+  }
+
+  bool inflate_to_volume(PathPoint& state, double target_volume, std::string& message) {
+    double step = target_volume - state.volume;
+    const double smallest = 1e-4 * std::abs(target_volume - state.volume) + 1e-12 * target_volume;
+    NewtonReport report;
+    if (std::abs(step) <= 1e-14 * target_volume) {
+      // Already there in volume; still solve for equilibrium.
+      return volume_step(state, target_volume, report) || (message = "no equilibrium found: " + report.message, false);
+    }
+    while (std::abs(target_volume - state.volume) > 1e-14 * target_volume) {
+      const double next = std::abs(step) >= std::abs(target_volume - state.volume) ? target_volume : state.volume + step;
+      if (volume_step(state, next, report)) {
+        if (report.iterations <= 6) step *= 2.0;
+        continue;
+      }
+      if (stopped(report)) {
+        message = report.message;
+        return false;
+      }
+      step *= 0.5;
+      if (std::abs(step) < smallest) {
+        message = "no equilibrium found at volume ratio " + std::to_string(next / m_model.volume(flat_rest())) +
+                  " (" + report.message + ", residual " + std::to_string(report.residual_norm) + " N)";
+        return false;
+      }
+    }
+    return true;
+  }
+
+  Eigen::VectorXd flat_rest() const {
+    return Eigen::Map<const Eigen::VectorXd>(m_rest.vertices.data(), m_rest.vertices.size());
+  }
+
+  /// Pressure control: follow the volume path until the pressure reaches the target, then solve at
+  /// that pressure. A target above the balloon's pressure maximum has no equilibrium and says so.
+  bool inflate_to_pressure(PathPoint& state, double target_pressure, std::string& message) {
+    if (target_pressure <= 0.0) {
+      message = "pressure must be positive";
+      return false;
+    }
+    const double rest_volume = m_model.volume(flat_rest());
+    double step = 0.5 * rest_volume;
+    double peak_pressure = state.pressure;
+    NewtonReport report;
+    while (state.pressure < target_pressure) {
+      PathPoint previous = state;
+      if (!volume_step(state, state.volume + step, report)) {
+        if (stopped(report)) {
+          message = report.message;
+          return false;
+        }
+        step *= 0.5;
+        if (step < 1e-5 * rest_volume) {
+          message = "no equilibrium found on the way to " + format_kpa(target_pressure) + " (" + report.message + ")";
+          return false;
+        }
+        continue;
+      }
+      peak_pressure = std::max(peak_pressure, state.pressure);
+      if (state.pressure < previous.pressure && previous.pressure < target_pressure) {
+        message = "no equilibrium: " + format_kpa(target_pressure) + " exceeds the balloon's maximum pressure of about " +
+                  format_kpa(peak_pressure) + " (use volume control to pass it)";
+        return false;
+      }
+      if (state.volume > 1e6 * rest_volume) {
+        message = "no equilibrium below volume ratio 1e6 for " + format_kpa(target_pressure);
+        return false;
+      }
+      if (state.pressure >= target_pressure) {
+        // Bracketed: interpolate between the two path points, then solve at the exact pressure.
+        const double theta = (target_pressure - previous.pressure) / (state.pressure - previous.pressure);
+        Eigen::VectorXd x = previous.x + theta * (state.x - previous.x);
+        report = m_solver.solve_pressure(x, target_pressure, m_settings);
+        m_newton_iterations += report.iterations;
+        if (!report.converged) {
+          message = "no equilibrium found at " + format_kpa(target_pressure) + " (" + report.message + ", residual " +
+                    std::to_string(report.residual_norm) + " N)";
+          state.x = x;
+          state.pressure = target_pressure;
+          state.volume = m_model.volume(x);
+          return false;
+        }
+        state = {x, target_pressure, m_model.volume(x)};
+        m_residual = report.residual_norm;
+        return true;
+      }
+      if (report.iterations <= 6) step *= 2.0;
+    }
+    return true;
+  }
+
+  void fill(InflationResult& result, const PathPoint& state) {
+    result.deformed = unflatten(state.x);
+    result.pressure_kpa = state.pressure / MPA_PER_KPA;
+    result.volume_mm3 = m_model.volume(state.x);
+    result.volume_ratio = result.volume_mm3 / result.rest_volume_mm3;
+    result.mean_stretch = std::sqrt(m_model.area(state.x) / m_model.rest_area());
+    result.max_stretch = m_model.max_stretch(state.x);
+    // Residual over every coordinate except user-held ones: the rigid support must carry no load.
+    Eigen::VectorXd r = m_model.elastic_gradient(state.x) - state.pressure * m_model.volume_gradient(state.x);
+    for (int v : m_options.fixed_vertices) r.segment<3>(3 * v).setZero();
+    result.residual_norm = r.norm();
+    result.newton_iterations = m_newton_iterations;
+    result.factorizations = m_solver.factorizations();
+    result.load_steps = m_load_steps;
+    result.time_s = now_s() - m_start;
+  }
+
+  const TriMesh& m_rest;
+  const InflationOptions& m_options;
+  fem::BalloonModel m_model;
+  std::vector<bool> m_fixed;
+  EquilibriumSolver m_solver;
+  NewtonSettings m_settings;
+  double m_start;
+  int m_newton_iterations = 0;
+  int m_load_steps = 0;
+  double m_residual = 0.0;
+};
+
+std::string options_problem(const TriMesh& rest, const InflationOptions& options) {
+  if (rest.vertex_count() < 3 || rest.face_count() < 1) return "the rest mesh is empty";
+  if (!rest.vertices.allFinite()) return "the rest mesh has non-finite coordinates";
+  if (auto problem = material_problem(options.material); !problem.empty()) return problem;
+  if (options.element_thickness_mm.empty()) {
+    if (!(options.thickness_mm > 0.0) || !std::isfinite(options.thickness_mm)) return "thickness must be positive (mm)";
+  } else {
+    if (static_cast<int>(options.element_thickness_mm.size()) != rest.face_count())
+      return "per-triangle thickness needs one value per triangle";
+    for (double h : options.element_thickness_mm)
+      if (!(h > 0.0) || !std::isfinite(h)) return "per-triangle thickness must be positive (mm)";
+  }
+  if (options.control == InflationControl::VolumeRatio &&
+      (!(options.volume_ratio > 0.0) || !std::isfinite(options.volume_ratio)))
+    return "volume ratio must be a positive number";
+  if (options.control == InflationControl::Pressure &&
+      (!(options.pressure_kpa > 0.0) || !std::isfinite(options.pressure_kpa)))
+    return "pressure must be a positive number (kPa)";
+  for (int v : options.fixed_vertices)
+    if (v < 0 || v >= rest.vertex_count()) return "fixed vertex " + std::to_string(v) + " does not exist";
+  return "";
+}
+
+}  // namespace
+
+InflationResult inflate(const TriMesh& rest, const InflationOptions& options, const Positions* initial_guess) {
+  if (auto problem = options_problem(rest, options); !problem.empty()) {
+    InflationResult result;
+    result.message = problem;
+    result.deformed = rest.vertices;
+    return result;
+  }
+  InflationRun run(rest, options);
+  return run.run(initial_guess);
+}
+
+}  // namespace balloon

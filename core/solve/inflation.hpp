@@ -1,0 +1,53 @@
+#pragma once
+/// Static inflation of a closed membrane: the equilibrium shape under a given pressure, or at a given
+/// enclosed volume with the pressure as an unknown (volume control passes pressure maxima).
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "material/material.hpp"
+#include "mesh/tri_mesh.hpp"
+#include "progress.hpp"
+
+namespace balloon {
+
+enum class InflationControl { Pressure, VolumeRatio };
+
+struct InflationOptions {
+  Material material;
+  double thickness_mm = 0.5;                 ///< rest membrane thickness h (mm), uniform
+  std::vector<double> element_thickness_mm;  ///< optional per-triangle thickness (mm); overrides thickness_mm
+  InflationControl control = InflationControl::VolumeRatio;
+  double pressure_kpa = 0.0;                 ///< target pressure (kPa) under pressure control
+  double volume_ratio = 1.0;                 ///< target V / V_rest under volume control
+  std::vector<int> fixed_vertices;           ///< vertices held at their rest positions (clamped rim, nozzle)
+  double residual_tolerance = 1e-8;          ///< stop when |f| <= tol * (p * A_rest), relative force residual
+  int max_newton_iterations = 200;           ///< over all load steps
+  double max_time_s = 0.0;                   ///< wall-time budget (s); 0 means none
+  ProgressCallback progress;                 ///< optional
+  const CancelToken* cancel = nullptr;       ///< optional
+};
+
+struct InflationResult {
+  bool converged = false;
+  std::string message;            ///< why it stopped; names the failure when not converged
+  Positions deformed;             ///< #V by 3 equilibrium positions (mm)
+  double pressure_kpa = 0.0;      ///< equilibrium pressure (kPa)
+  double volume_mm3 = 0.0;        ///< enclosed volume of the deformed mesh (mm^3)
+  double rest_volume_mm3 = 0.0;   ///< enclosed volume of the rest mesh (mm^3)
+  double volume_ratio = 0.0;      ///< volume_mm3 / rest_volume_mm3
+  double mean_stretch = 0.0;      ///< sqrt(A / A_rest), area-mean extension ratio
+  double max_stretch = 0.0;       ///< largest principal stretch over all triangles
+  double residual_norm = 0.0;     ///< |f_mem + f_p| over all free coordinates (N)
+  int newton_iterations = 0;
+  int factorizations = 0;
+  int load_steps = 0;
+  double time_s = 0.0;
+};
+
+/// Inflates `rest` (a closed, outward-oriented mesh in mm). `initial_guess` (#V by 3, mm) warm-starts
+/// the solve; without it the rest shape scaled about its centroid is used.
+InflationResult inflate(const TriMesh& rest, const InflationOptions& options,
+                        const Positions* initial_guess = nullptr);
+
+}  // namespace balloon

@@ -1,0 +1,133 @@
+#include "solve/sparse_solver.hpp"
+
+#include <cholmod.h>
+
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+namespace balloon {
+
+struct SparseSolver::Internals {
+  cholmod_common common{};
+  cholmod_sparse* matrix = nullptr;
+  cholmod_factor* llt = nullptr;   // supernodal symbolic + numeric
+  cholmod_factor* ldlt = nullptr;  // simplicial symbolic + numeric
+  cholmod_factor* last = nullptr;  // the factor solve() uses
+  int n = 0;
+  int negative = 0;
+
+  Internals() {
+    cholmod_start(&common);
+    common.print = 0;
+    common.error_handler = nullptr;
+  }
+  ~Internals() {
+    if (llt) cholmod_free_factor(&llt, &common);
+    if (ldlt) cholmod_free_factor(&ldlt, &common);
+    if (matrix) cholmod_free_sparse(&matrix, &common);
+    cholmod_finish(&common);
+  }
+
+  void copy_values(const std::vector<double>& values) {
+    if (values.size() != matrix->nzmax) throw std::invalid_argument("SparseSolver: value count does not match the pattern");
+    for (double v : values)
+      if (!std::isfinite(v)) throw std::invalid_argument("SparseSolver: non-finite matrix entry");
+    std::memcpy(matrix->x, values.data(), values.size() * sizeof(double));
+  }
+};
+
+SparseSolver::SparseSolver() : m(std::make_unique<Internals>()) {}
+SparseSolver::~SparseSolver() = default;
+
+void SparseSolver::set_pattern(int n, const std::vector<int>& column_starts, const std::vector<int>& row_indices) {
+  if (m->llt) cholmod_free_factor(&m->llt, &m->common);
+  if (m->ldlt) cholmod_free_factor(&m->ldlt, &m->common);
+  if (m->matrix) cholmod_free_sparse(&m->matrix, &m->common);
+  m->last = nullptr;
+  m->n = n;
+  m->matrix = cholmod_allocate_sparse(static_cast<size_t>(n), static_cast<size_t>(n), row_indices.size(), 1, 1, 1,
+                                      CHOLMOD_REAL, &m->common);
+  if (!m->matrix) throw std::runtime_error("SparseSolver: CHOLMOD could not allocate the matrix");
+  std::memcpy(m->matrix->p, column_starts.data(), column_starts.size() * sizeof(int));
+  std::memcpy(m->matrix->i, row_indices.data(), row_indices.size() * sizeof(int));
+}
+
+SparseSolver::Status SparseSolver::factorize_llt(const std::vector<double>& values, double shift) {
+  m->copy_values(values);
+  if (!m->llt) {
+    m->common.supernodal = CHOLMOD_SUPERNODAL;
+    m->common.final_ll = 1;
+    m->llt = cholmod_analyze(m->matrix, &m->common);
+    if (!m->llt) return Status::Failed;
+  }
+  m->common.supernodal = CHOLMOD_SUPERNODAL;
+  m->common.final_ll = 1;
+  m->common.quick_return_if_not_posdef = 1;
+  double beta[2] = {shift, 0.0};
+  ++m_factorizations;
+  const int ok = cholmod_factorize_p(m->matrix, beta, nullptr, 0, m->llt, &m->common);
+  m->negative = 0;
+  if (!ok) return Status::Failed;
+  if (m->common.status == CHOLMOD_NOT_POSDEF || m->llt->minor < m->llt->n) {
+    m->last = nullptr;
+    return Status::NotPositiveDefinite;
+  }
+  m->last = m->llt;
+  return Status::Ok;
+}
+
+SparseSolver::Status SparseSolver::factorize_ldlt(const std::vector<double>& values, double shift) {
+  m->copy_values(values);
+  if (!m->ldlt) {
+    m->common.supernodal = CHOLMOD_SIMPLICIAL;
+    m->common.final_ll = 0;
+    m->ldlt = cholmod_analyze(m->matrix, &m->common);
+    if (!m->ldlt) return Status::Failed;
+  }
+  m->common.supernodal = CHOLMOD_SIMPLICIAL;
+  m->common.final_ll = 0;
+  double beta[2] = {shift, 0.0};
+  ++m_factorizations;
+  const int ok = cholmod_factorize_p(m->matrix, beta, nullptr, 0, m->ldlt, &m->common);
+  if (!ok) return Status::Failed;
+  // Simplicial LDL^T keeps D as the first entry of each column.
+  const auto* p = static_cast<const int*>(m->ldlt->p);
+  const auto* x = static_cast<const double*>(m->ldlt->x);
+  m->negative = 0;
+  bool singular = m->ldlt->minor < m->ldlt->n;
+  for (int j = 0; j < m->n && !singular; ++j) {
+    const double d = x[p[j]];
+    if (!std::isfinite(d) || d == 0.0) singular = true;
+    if (d < 0.0) ++m->negative;
+  }
+  if (singular) {
+    m->last = nullptr;
+    return Status::Singular;
+  }
+  m->last = m->ldlt;
+  return Status::Ok;
+}
+
+int SparseSolver::negative_pivots() const { return m->negative; }
+
+Eigen::VectorXd SparseSolver::solve(const Eigen::VectorXd& rhs) const {
+  if (!m->last) throw std::logic_error("SparseSolver::solve without a successful factorization");
+  if (rhs.size() != m->n) throw std::invalid_argument("SparseSolver::solve: size mismatch");
+  if (!rhs.allFinite()) throw std::invalid_argument("SparseSolver::solve: non-finite right-hand side");
+  cholmod_dense b{};
+  b.nrow = static_cast<size_t>(m->n);
+  b.ncol = 1;
+  b.nzmax = static_cast<size_t>(m->n);
+  b.d = static_cast<size_t>(m->n);
+  b.x = const_cast<double*>(rhs.data());
+  b.xtype = CHOLMOD_REAL;
+  b.dtype = CHOLMOD_DOUBLE;
+  cholmod_dense* x = cholmod_solve(CHOLMOD_A, m->last, &b, &m->common);
+  if (!x) throw std::runtime_error("SparseSolver::solve: CHOLMOD solve failed");
+  Eigen::VectorXd out = Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(x->x), m->n);
+  cholmod_free_dense(&x, &m->common);
+  return out;
+}
+
+}  // namespace balloon

@@ -1,0 +1,128 @@
+#include "jobs/simulate_job.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "jobs/json_writer.hpp"
+#include "mesh/mesh_checks.hpp"
+
+namespace balloon::jobs {
+namespace {
+
+std::string format_number(double value, const char* format = "%.6g") {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), format, value);
+  return buffer;
+}
+
+}  // namespace
+
+std::string simulate_parameters_problem(const SimulateParameters& parameters) {
+  if (!std::isfinite(parameters.thickness_mm) || parameters.thickness_mm <= 0.0)
+    return "thickness must be a positive number of mm, got " + format_number(parameters.thickness_mm);
+  if (parameters.pressure_kpa && parameters.volume_ratio)
+    return "give either a pressure or a volume ratio, not both";
+  if (!parameters.pressure_kpa && !parameters.volume_ratio)
+    return "give a pressure (kPa) or a volume ratio";
+  if (parameters.pressure_kpa && (!std::isfinite(*parameters.pressure_kpa) || *parameters.pressure_kpa <= 0.0))
+    return "pressure must be a positive number of kPa, got " + format_number(*parameters.pressure_kpa);
+  if (parameters.volume_ratio && (!std::isfinite(*parameters.volume_ratio) || *parameters.volume_ratio <= 0.0))
+    return "volume ratio must be a positive number, got " + format_number(*parameters.volume_ratio);
+  return "";
+}
+
+Result<SimulateInput> prepare_simulate(TriMesh rest, const Material& material,
+                                       const SimulateParameters& parameters) {
+  if (const std::string problem = simulate_parameters_problem(parameters); !problem.empty()) return fail(problem);
+  if (const std::string problem = material_problem(material); !problem.empty())
+    return fail("material: " + problem);
+
+  Result<MeshCheckReport> report = validate_balloon_mesh(rest);
+  if (!report) return fail("mesh: " + report.error());
+
+  SimulateInput input;
+  input.flipped_orientation = report->flipped;
+  input.rest = std::move(rest);
+  input.material = material;
+  input.thickness_mm = parameters.thickness_mm;
+  if (parameters.pressure_kpa) {
+    input.control = InflationControl::Pressure;
+    input.pressure_kpa = *parameters.pressure_kpa;
+  } else {
+    input.control = InflationControl::VolumeRatio;
+    input.volume_ratio = *parameters.volume_ratio;
+  }
+  return input;
+}
+
+SimulateOutcome run_simulate(const SimulateInput& input, const RunControls& controls) {
+  InflationOptions options;
+  options.material = input.material;
+  options.thickness_mm = input.thickness_mm;
+  options.control = input.control;
+  options.pressure_kpa = input.pressure_kpa;
+  options.volume_ratio = input.volume_ratio;
+  options.max_time_s = controls.max_time_s;
+  options.progress = controls.progress;
+  options.cancel = controls.cancel;
+
+  SimulateOutcome outcome;
+  outcome.result = inflate(input.rest, options);
+  outcome.cancelled = controls.cancel != nullptr && controls.cancel->cancelled() && !outcome.result.converged;
+  outcome.report_json = simulate_report_json(input, outcome.result);
+  return outcome;
+}
+
+std::string simulate_report_json(const SimulateInput& input, const InflationResult& result) {
+  JsonWriter json;
+  json.begin_object()
+      .value("converged", result.converged)
+      .value("pressure_kpa", result.pressure_kpa)
+      .value("volume_mm3", result.volume_mm3)
+      .value("rest_volume_mm3", result.rest_volume_mm3)
+      .value("volume_ratio", result.volume_ratio)
+      .value("mean_stretch", result.mean_stretch)
+      .value("max_stretch", result.max_stretch)
+      .value("newton_iterations", result.newton_iterations)
+      .value("factorizations", result.factorizations)
+      .value("load_steps", result.load_steps)
+      .value("residual_norm", result.residual_norm)
+      .value("time_s", result.time_s)
+      .value("vertices", input.rest.vertex_count())
+      .value("faces", input.rest.face_count())
+      .value("material", material_spec(input.material))
+      .value("material_name", input.material.name)
+      .value("thickness_mm", input.thickness_mm)
+      .value("control", input.control == InflationControl::Pressure ? "pressure" : "volume_ratio");
+  if (input.control == InflationControl::Pressure)
+    json.value("target_pressure_kpa", input.pressure_kpa);
+  else
+    json.value("target_volume_ratio", input.volume_ratio);
+  json.value("flipped_orientation", input.flipped_orientation)
+      .value("message", result.message)
+      .end_object();
+  return json.str();
+}
+
+std::string simulate_summary_text(const SimulateInput& input, const InflationResult& result) {
+  std::ostringstream out;
+  out << (result.converged ? "converged" : "NOT converged") << " after " << result.newton_iterations
+      << " Newton iterations (" << result.load_steps << " load steps, " << result.factorizations
+      << " factorizations) in " << format_number(result.time_s, "%.3f") << " s\n";
+  if (!result.message.empty()) out << "  " << result.message << "\n";
+  out << "  material       " << material_spec(input.material);
+  if (!input.material.name.empty()) out << " (" << input.material.name << ")";
+  out << ", thickness " << format_number(input.thickness_mm) << " mm\n";
+  out << "  mesh           " << input.rest.vertex_count() << " vertices, " << input.rest.face_count() << " faces"
+      << (input.flipped_orientation ? " (flipped to face outwards)" : "") << "\n";
+  out << "  pressure       " << format_number(result.pressure_kpa) << " kPa\n";
+  out << "  volume         " << format_number(result.volume_mm3) << " mm^3 (rest " << format_number(result.rest_volume_mm3)
+      << " mm^3, ratio " << format_number(result.volume_ratio) << ")\n";
+  out << "  stretch        mean " << format_number(result.mean_stretch) << ", max " << format_number(result.max_stretch)
+      << "\n";
+  out << "  residual norm  " << format_number(result.residual_norm, "%.3e") << " N\n";
+  return out.str();
+}
+
+}  // namespace balloon::jobs

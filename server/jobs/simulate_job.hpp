@@ -1,0 +1,69 @@
+#pragma once
+/// The simulate job without any transport: check the request, inflate, and describe the outcome.
+/// The CLI and the gRPC service both run simulations through this layer, so their reports agree.
+#include <optional>
+#include <string>
+
+#include "material/material.hpp"
+#include "mesh/tri_mesh.hpp"
+#include "progress.hpp"
+#include "result.hpp"
+#include "solve/inflation.hpp"
+
+namespace balloon::jobs {
+
+/// Default rest membrane thickness (mm) when a request names none.
+inline constexpr double DEFAULT_THICKNESS_MM = 0.5;
+
+/// How a user asked to load the membrane. Exactly one of pressure_kpa and volume_ratio is set.
+struct SimulateParameters {
+  double thickness_mm = DEFAULT_THICKNESS_MM;  ///< rest thickness h (mm), > 0
+  std::optional<double> pressure_kpa;          ///< pressure control (kPa), > 0
+  std::optional<double> volume_ratio;          ///< volume control: target V / V_rest, > 0
+};
+
+/// A simulate job whose inputs have all been checked: ready to run.
+struct SimulateInput {
+  TriMesh rest;                     ///< validated rest mesh (mm), oriented outwards
+  bool flipped_orientation = false; ///< the mesh came oriented inwards and was flipped
+  Material material;                ///< law and constants (MPa)
+  double thickness_mm = DEFAULT_THICKNESS_MM;
+  InflationControl control = InflationControl::VolumeRatio;
+  double pressure_kpa = 0.0;        ///< pressure control target (kPa)
+  double volume_ratio = 1.0;        ///< volume control target V / V_rest
+};
+
+/// Empty when the parameters are usable, else a one-line message naming the problem.
+std::string simulate_parameters_problem(const SimulateParameters& parameters);
+
+/// Checks the parameters, the material constants and the mesh (closed, manifold, finite, ...); an
+/// inward-oriented mesh is flipped. The error names the problem (and the face or vertex).
+Result<SimulateInput> prepare_simulate(TriMesh rest, const Material& material,
+                                       const SimulateParameters& parameters);
+
+/// What the outside world gives a run: where progress goes, how to stop it, how long it may take.
+struct RunControls {
+  ProgressCallback progress;            ///< optional
+  const CancelToken* cancel = nullptr;  ///< optional
+  double max_time_s = 0.0;              ///< wall-time budget (s); 0 means none
+};
+
+/// The finished run and its report.
+struct SimulateOutcome {
+  InflationResult result;   ///< equilibrium (or the last iterate when not converged)
+  std::string report_json;  ///< see simulate_report_json
+  bool cancelled = false;   ///< the cancel token fired before the run finished
+};
+
+/// Inflates a prepared job. Never throws for non-convergence: that is `result.converged == false`.
+SimulateOutcome run_simulate(const SimulateInput& input, const RunControls& controls);
+
+/// One JSON object: converged, pressure_kpa, volume_mm3, rest_volume_mm3, volume_ratio, mean_stretch,
+/// max_stretch, newton_iterations, factorizations, load_steps, residual_norm (N), time_s, vertices,
+/// faces, material (SPEC), material_name, thickness_mm, control, flipped_orientation, message.
+std::string simulate_report_json(const SimulateInput& input, const InflationResult& result);
+
+/// A few human-readable lines with units, for a terminal.
+std::string simulate_summary_text(const SimulateInput& input, const InflationResult& result);
+
+}  // namespace balloon::jobs

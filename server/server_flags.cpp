@@ -1,0 +1,168 @@
+#include "server_flags.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <thread>
+
+namespace balloon::server {
+namespace {
+
+const std::map<std::string, bool>& known_flags() {
+  // name -> takes a value
+  static const std::map<std::string, bool> flags = {
+      {"listen", true},       {"db", true},           {"workers", true},     {"max-queue", true},
+      {"token-file", true},   {"tls-cert", true},     {"tls-key", true},     {"insecure-listen-any", false},
+      {"max-message-mb", true}, {"max-mesh-vertices", true}, {"job-time-limit", true},
+      {"progress-mesh-every", true}, {"quiet", false}, {"config", true}, {"help", false},
+  };
+  return flags;
+}
+
+Result<long long> to_integer(const std::string& flag, const std::string& text, long long min_value, long long max_value) {
+  errno = 0;
+  char* end = nullptr;
+  const long long value = std::strtoll(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0' || errno == ERANGE) return fail("--" + flag + ": '" + text + "' is not an integer");
+  if (value < min_value || value > max_value)
+    return fail("--" + flag + ": " + text + " is outside " + std::to_string(min_value) + ".." + std::to_string(max_value));
+  return value;
+}
+
+Result<double> to_number(const std::string& flag, const std::string& text) {
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || !std::isfinite(value) || value <= 0.0)
+    return fail("--" + flag + ": '" + text + "' is not a positive number");
+  return value;
+}
+
+std::string trim(const std::string& s) {
+  const auto begin = s.find_first_not_of(" \t\r");
+  if (begin == std::string::npos) return "";
+  return s.substr(begin, s.find_last_not_of(" \t\r") - begin + 1);
+}
+
+Result<bool> read_config_file(const std::string& path, std::vector<std::pair<std::string, std::string>>& settings) {
+  std::ifstream in(path);
+  if (!in) return fail("cannot read config file '" + path + "'");
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    line = trim(line);
+    if (line.empty() || line[0] == '#') continue;
+    const auto eq = line.find('=');
+    const std::string name = trim(line.substr(0, eq));
+    const std::string value = eq == std::string::npos ? "" : trim(line.substr(eq + 1));
+    const auto flag = known_flags().find(name);
+    if (flag == known_flags().end() || name == "config" || name == "help")
+      return fail("config file '" + path + "' line " + std::to_string(number) + ": unknown setting '" + name + "'");
+    if (flag->second && eq == std::string::npos)
+      return fail("config file '" + path + "' line " + std::to_string(number) + ": '" + name + "' needs '= value'");
+    // Booleans: "name" or "name = true|false".
+    if (!flag->second && (value == "false" || value == "0")) continue;
+    settings.emplace_back(name, value);
+  }
+  return true;
+}
+
+}  // namespace
+
+std::string server_usage() {
+  return "Usage: balloon-server [--listen ADDR] [--db PATH] [--workers N] [--max-queue N] [--token-file F]\n"
+         "                      [--tls-cert F --tls-key F] [options]\n\n"
+         "Runs the balloon design service (gRPC, package balloon.v1) with a job queue, worker threads and a\n"
+         "SQLite store. Stops cleanly on SIGTERM or SIGINT: running jobs go back to the queue in the store\n"
+         "and run again at the next start.\n\n"
+         "Options (default in brackets):\n"
+         "  --listen ADDR            address to listen on, host:port or unix:PATH [127.0.0.1:50051]; port 0 picks one\n"
+         "  --db PATH                SQLite database file [balloon.db]\n"
+         "  --workers N              worker threads running jobs [number of cores]\n"
+         "  --max-queue N            queued jobs at most; more get RESOURCE_EXHAUSTED [1000]\n"
+         "  --max-message-mb N       largest request or response in MiB [64]\n"
+         "  --max-mesh-vertices N    largest mesh accepted, in vertices [200000]\n"
+         "  --job-time-limit S       wall-time limit per job in seconds [3600]\n"
+         "  --progress-mesh-every K  stream the intermediate mesh every K shape updates [1]\n"
+         "  --token-file F           require 'authorization: Bearer <token>'; lines 'TENANT TOKEN' [none]\n"
+         "  --tls-cert F, --tls-key F  serve TLS with this PEM certificate chain and key [plaintext]\n"
+         "  --insecure-listen-any    allow a non-loopback address without a token file [off]\n"
+         "  --quiet                  no per-job log lines on stderr [off]\n"
+         "  --config FILE            read 'name = value' settings first (names as the flags) [none]\n"
+         "  --help                   this text\n\n"
+         "Health checking (grpc.health.v1) and server reflection are enabled.\n";
+}
+
+Result<ServerCommand> parse_server_flags(const std::vector<std::string>& args) {
+  std::vector<std::pair<std::string, std::string>> settings;
+  std::vector<std::pair<std::string, std::string>> from_command_line;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& word = args[i];
+    if (word.rfind("--", 0) != 0) return fail("unexpected argument '" + word + "'");
+    std::string name = word.substr(2), value;
+    bool inline_value = false;
+    if (const auto eq = name.find('='); eq != std::string::npos) {
+      value = name.substr(eq + 1);
+      name = name.substr(0, eq);
+      inline_value = true;
+    }
+    const auto flag = known_flags().find(name);
+    if (flag == known_flags().end()) return fail("unknown option '--" + name + "'");
+    if (flag->second && !inline_value) {
+      if (i + 1 >= args.size()) return fail("option '--" + name + "' needs a value");
+      value = args[++i];
+    }
+    if (name == "config") {
+      Result<bool> read = read_config_file(value, settings);
+      if (!read) return fail(read.error());
+      continue;
+    }
+    from_command_line.emplace_back(name, value);
+  }
+  settings.insert(settings.end(), from_command_line.begin(), from_command_line.end());
+
+  ServerCommand command;
+  rpc::ServerConfig& config = command.config;
+  config.listen_address = "127.0.0.1:50051";
+  for (const auto& [name, value] : settings) {
+    if (name == "help") command.help = true;
+    else if (name == "quiet") command.quiet = true;
+    else if (name == "insecure-listen-any") config.insecure_listen_any = true;
+    else if (name == "listen") config.listen_address = value;
+    else if (name == "db") config.service.db_path = value;
+    else if (name == "token-file") config.token_file = value;
+    else if (name == "tls-cert") config.tls_cert_file = value;
+    else if (name == "tls-key") config.tls_key_file = value;
+    else if (name == "workers") {
+      Result<long long> n = to_integer(name, value, 1, 1024);
+      if (!n) return fail(n.error());
+      config.service.workers = static_cast<int>(*n);
+    } else if (name == "max-queue") {
+      Result<long long> n = to_integer(name, value, 1, 10000000);
+      if (!n) return fail(n.error());
+      config.service.max_queue = static_cast<int>(*n);
+    } else if (name == "max-message-mb") {
+      Result<long long> n = to_integer(name, value, 1, 2047);
+      if (!n) return fail(n.error());
+      config.max_message_bytes = static_cast<int>(*n) << 20;
+    } else if (name == "max-mesh-vertices") {
+      Result<long long> n = to_integer(name, value, 4, 100000000);
+      if (!n) return fail(n.error());
+      config.service.max_mesh_vertices = static_cast<int>(*n);
+    } else if (name == "job-time-limit") {
+      Result<double> s = to_number(name, value);
+      if (!s) return fail(s.error());
+      config.service.job_time_limit_s = *s;
+    } else if (name == "progress-mesh-every") {
+      Result<long long> n = to_integer(name, value, -1, 1000000);
+      if (!n) return fail(n.error());
+      config.service.progress_mesh_every = static_cast<int>(*n);
+    }
+  }
+  if (config.service.workers <= 0) config.service.workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return command;
+}
+
+}  // namespace balloon::server

@@ -1,0 +1,25 @@
+#pragma once
+/// balloon-server's command line (and optional key = value config file) into a ServerConfig.
+#include <string>
+#include <vector>
+
+#include "result.hpp"
+#include "rpc/grpc_server.hpp"
+
+namespace balloon::server {
+
+/// What the command line asked for.
+struct ServerCommand {
+  rpc::ServerConfig config;
+  bool help = false;   ///< print server_usage() and exit
+  bool quiet = false;  ///< no per-job log lines
+};
+
+/// Parses the words after the program name. `--config FILE` reads `name = value` lines (names as the
+/// flags without dashes; `#` comments) before the remaining flags, which override it.
+Result<ServerCommand> parse_server_flags(const std::vector<std::string>& args);
+
+/// The --help text, with every flag's default.
+std::string server_usage();
+
+}  // namespace balloon::server

@@ -1,0 +1,23 @@
+#pragma once
+/// Everything the service layer is configured with; balloon-server's flags fill it. Defaults are the
+/// documented flag defaults.
+#include <functional>
+#include <string>
+
+namespace balloon::service {
+
+struct ServiceOptions {
+  std::string db_path = "balloon.db";   ///< SQLite file; ":memory:" for a throw-away store
+  int workers = 0;                      ///< worker threads; 0 means the number of cores
+  int max_queue = 1000;                 ///< queued jobs at most (running ones not counted)
+  int max_mesh_vertices = 200000;       ///< larger meshes are refused (RESOURCE_EXHAUSTED)
+  double job_time_limit_s = 3600.0;     ///< per-job wall-time limit (s); a job may ask for less
+  int progress_mesh_every = 1;          ///< default K: every K-th shape-carrying progress event streams the mesh
+  double checkpoint_interval_s = 0.25;  ///< at most one stored progress checkpoint per job per interval (s)
+  bool recover = true;                  ///< re-queue unfinished jobs at start (only if no other process uses the store)
+  bool run_jobs = true;                 ///< false: accept and store jobs but start no workers (a short-lived CLI)
+  /// Receives one log line per job event; empty for silence (the embedded CLI server).
+  std::function<void(const std::string&)> log;
+};
+
+}  // namespace balloon::service

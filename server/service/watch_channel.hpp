@@ -1,0 +1,56 @@
+#pragma once
+/// One watcher's queue of job events, between the worker that publishes them and the stream that sends
+/// them. Knows nothing of gRPC: the stream registers a notifier and pulls events one at a time, so one
+/// slow watcher never blocks a worker (its old progress events are dropped instead).
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <vector>
+
+#include "balloon/v1/balloon.pb.h"
+#include "service/service_status.hpp"
+
+namespace balloon::service {
+
+class WatchChannel {
+ public:
+  /// Events waiting beyond this count make the channel drop its oldest progress-only events.
+  static constexpr std::size_t MAX_PENDING = 64;
+
+  /// Queues an event. A mesh event gets the job's connectivity if this watcher has not had it yet.
+  /// Ignored once the channel is closed.
+  void push(balloon::v1::JobEvent event, const std::shared_ptr<const std::vector<std::uint32_t>>& triangles);
+  /// Queues a last event and closes the channel with `status` (OK for a finished job).
+  void close(std::optional<balloon::v1::JobEvent> last_event, ServiceStatus status);
+
+  /// The next event, if any (for the sender).
+  std::optional<balloon::v1::JobEvent> pop();
+  /// True when closed and drained: the sender should finish with final_status().
+  bool finished() const;
+  ServiceStatus final_status() const;
+
+  /// Called (without the channel's lock) whenever an event is pushed or the channel closes.
+  /// Set to empty before the sender goes away; setting waits for a notification in progress.
+  void set_notifier(std::function<void()> notifier);
+
+  /// Events dropped because the watcher was slow.
+  std::uint64_t dropped() const;
+
+ private:
+  void notify();
+
+  mutable std::mutex m_mutex;
+  std::deque<balloon::v1::JobEvent> m_events;
+  bool m_closed = false;
+  bool m_sent_connectivity = false;
+  ServiceStatus m_status;
+  std::uint64_t m_dropped = 0;
+
+  std::recursive_mutex m_notifier_mutex;  // recursive: a notifier may re-enter through a synchronous callback
+  std::function<void()> m_notifier;
+};
+
+}  // namespace balloon::service

@@ -1,0 +1,145 @@
+#include "store/database.hpp"
+
+#include <sqlite3.h>
+
+namespace balloon::store {
+namespace {
+
+[[noreturn]] void throw_error(sqlite3* db, const std::string& what) {
+  throw DatabaseError(what + ": " + (db != nullptr ? sqlite3_errmsg(db) : "out of memory"));
+}
+
+}  // namespace
+
+Database::Database(const std::string& path, int busy_timeout_ms) : m_path(path) {
+  const int flags = SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX;
+  if (sqlite3_open_v2(path.c_str(), &m_db, flags, nullptr) != SQLITE_OK) {
+    const std::string message = m_db != nullptr ? sqlite3_errmsg(m_db) : "out of memory";
+    sqlite3_close(m_db);
+    m_db = nullptr;
+    throw DatabaseError("cannot open database '" + path + "': " + message);
+  }
+  sqlite3_extended_result_codes(m_db, 1);
+  sqlite3_busy_timeout(m_db, busy_timeout_ms);
+  // WAL lets readers proceed during a write; synchronous=FULL makes every commit durable across power
+  // loss, which is what "a job is in the database before SubmitJob returns" needs.
+  if (path != ":memory:") execute("PRAGMA journal_mode = WAL");
+  execute("PRAGMA synchronous = FULL; PRAGMA foreign_keys = ON");
+}
+
+Database::~Database() {
+  // Every Statement has been finalized by now (they cannot outlive a Database in our code), so close
+  // succeeds; close_v2 would defer otherwise rather than leak.
+  sqlite3_close_v2(m_db);
+}
+
+void Database::execute(std::string_view sql) {
+  char* message = nullptr;
+  const std::string text(sql);
+  if (sqlite3_exec(m_db, text.c_str(), nullptr, nullptr, &message) != SQLITE_OK) {
+    const std::string error = message != nullptr ? message : "unknown error";
+    sqlite3_free(message);
+    throw DatabaseError("executing '" + text.substr(0, 60) + "': " + error);
+  }
+}
+
+Statement Database::prepare(std::string_view sql) {
+  sqlite3_stmt* statement = nullptr;
+  if (sqlite3_prepare_v2(m_db, sql.data(), static_cast<int>(sql.size()), &statement, nullptr) != SQLITE_OK)
+    throw_error(m_db, "preparing '" + std::string(sql.substr(0, 60)) + "'");
+  return Statement(*this, statement);
+}
+
+std::int64_t Database::last_insert_id() const { return sqlite3_last_insert_rowid(m_db); }
+int Database::changes() const { return sqlite3_changes(m_db); }
+
+Statement::Statement(Statement&& other) noexcept
+    : m_database(other.m_database), m_statement(other.m_statement) {
+  other.m_statement = nullptr;
+}
+
+Statement::~Statement() { sqlite3_finalize(m_statement); }
+
+Statement& Statement::bind(int index, std::int64_t value) {
+  if (sqlite3_bind_int64(m_statement, index, value) != SQLITE_OK) throw_error(m_database->m_db, "bind");
+  return *this;
+}
+
+Statement& Statement::bind(int index, double value) {
+  if (sqlite3_bind_double(m_statement, index, value) != SQLITE_OK) throw_error(m_database->m_db, "bind");
+  return *this;
+}
+
+Statement& Statement::bind(int index, std::string_view text) {
+  if (sqlite3_bind_text64(m_statement, index, text.data(), text.size(), SQLITE_TRANSIENT, SQLITE_UTF8) != SQLITE_OK)
+    throw_error(m_database->m_db, "bind");
+  return *this;
+}
+
+Statement& Statement::bind_blob(int index, std::string_view bytes) {
+  // A zero-length blob must still be a blob, not NULL: pass a non-null pointer.
+  static const char empty = 0;
+  const char* data = bytes.empty() ? &empty : bytes.data();
+  if (sqlite3_bind_blob64(m_statement, index, data, bytes.size(), SQLITE_TRANSIENT) != SQLITE_OK)
+    throw_error(m_database->m_db, "bind");
+  return *this;
+}
+
+Statement& Statement::bind_null(int index) {
+  if (sqlite3_bind_null(m_statement, index) != SQLITE_OK) throw_error(m_database->m_db, "bind");
+  return *this;
+}
+
+bool Statement::step() {
+  const int rc = sqlite3_step(m_statement);
+  if (rc == SQLITE_ROW) return true;
+  if (rc == SQLITE_DONE) return false;
+  throw_error(m_database->m_db, "step");
+}
+
+void Statement::run() {
+  while (step()) {
+  }
+}
+
+void Statement::reset() {
+  sqlite3_reset(m_statement);
+  sqlite3_clear_bindings(m_statement);
+}
+
+std::int64_t Statement::column_int64(int column) const { return sqlite3_column_int64(m_statement, column); }
+double Statement::column_double(int column) const { return sqlite3_column_double(m_statement, column); }
+
+std::string Statement::column_text(int column) const {
+  const auto* text = reinterpret_cast<const char*>(sqlite3_column_text(m_statement, column));
+  if (text == nullptr) return {};
+  return std::string(text, static_cast<std::size_t>(sqlite3_column_bytes(m_statement, column)));
+}
+
+std::string Statement::column_blob(int column) const {
+  const auto* data = static_cast<const char*>(sqlite3_column_blob(m_statement, column));
+  if (data == nullptr) return {};
+  return std::string(data, static_cast<std::size_t>(sqlite3_column_bytes(m_statement, column)));
+}
+
+bool Statement::column_is_null(int column) const {
+  return sqlite3_column_type(m_statement, column) == SQLITE_NULL;
+}
+
+Transaction::Transaction(Database& database) : m_database(database) { m_database.execute("BEGIN IMMEDIATE"); }
+
+Transaction::~Transaction() {
+  if (m_done) return;
+  try {
+    m_database.execute("ROLLBACK");
+  } catch (...) {
+    // A failed rollback leaves SQLite to roll back on close; a destructor must not throw.
+  }
+}
+
+void Transaction::commit() {
+  m_database.execute("COMMIT");
+  m_done = true;
+}
+
+}  // namespace balloon::store

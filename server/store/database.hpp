@@ -1,0 +1,106 @@
+#pragma once
+/// A thin RAII layer over one SQLite connection: the connection, prepared statements and transactions.
+/// sqlite3.h stays in database.cpp; errors from SQLite throw DatabaseError (they are not user input).
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+struct sqlite3;
+struct sqlite3_stmt;
+
+namespace balloon::store {
+
+/// A failed SQLite call: names the call and carries SQLite's message.
+class DatabaseError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class Statement;
+
+/// One open connection, in WAL mode with a busy timeout and foreign keys on. Not thread-safe: the owner
+/// serializes access (JobStore holds a mutex).
+class Database {
+ public:
+  /// Opens (creating if needed) the database at `path`; ":memory:" for a private in-memory one.
+  /// `busy_timeout_ms` is how long a write waits for another connection's lock (ms).
+  explicit Database(const std::string& path, int busy_timeout_ms = 5000);
+  ~Database();
+  Database(const Database&) = delete;
+  Database& operator=(const Database&) = delete;
+
+  /// Runs one or more statements that take no parameters and return no rows (DDL, PRAGMA).
+  void execute(std::string_view sql);
+  /// Prepares a statement (cached per SQL text would be an optimisation; preparing is ~µs here).
+  Statement prepare(std::string_view sql);
+
+  /// Row id of the last INSERT on this connection.
+  std::int64_t last_insert_id() const;
+  /// Rows changed by the last INSERT, UPDATE or DELETE.
+  int changes() const;
+  /// The path it was opened with.
+  const std::string& path() const { return m_path; }
+
+ private:
+  friend class Statement;
+  std::string m_path;
+  sqlite3* m_db = nullptr;
+};
+
+/// A prepared statement. Bind with 1-based indices (`?` placeholders), step through rows, read columns
+/// with 0-based indices. Finalized on destruction.
+class Statement {
+ public:
+  Statement(Statement&& other) noexcept;
+  Statement& operator=(Statement&&) = delete;
+  Statement(const Statement&) = delete;
+  ~Statement();
+
+  Statement& bind(int index, std::int64_t value);
+  Statement& bind(int index, int value) { return bind(index, static_cast<std::int64_t>(value)); }
+  Statement& bind(int index, double value);
+  Statement& bind(int index, std::string_view text);
+  Statement& bind(int index, const char* text) { return bind(index, std::string_view(text)); }
+  Statement& bind_blob(int index, std::string_view bytes);
+  Statement& bind_null(int index);
+
+  /// Advances to the next row: true while there is one, false when done.
+  bool step();
+  /// Runs a statement that returns no rows.
+  void run();
+  /// Clears bindings and rewinds, to run the statement again.
+  void reset();
+
+  std::int64_t column_int64(int column) const;
+  int column_int(int column) const { return static_cast<int>(column_int64(column)); }
+  double column_double(int column) const;
+  std::string column_text(int column) const;
+  std::string column_blob(int column) const;
+  bool column_is_null(int column) const;
+
+ private:
+  friend class Database;
+  Statement(Database& database, sqlite3_stmt* statement) : m_database(&database), m_statement(statement) {}
+  Database* m_database;
+  sqlite3_stmt* m_statement;
+};
+
+/// BEGIN IMMEDIATE on construction; rolls back on destruction unless commit() was called.
+/// IMMEDIATE takes the write lock up front, so a transaction never fails half-way on a lock upgrade.
+class Transaction {
+ public:
+  explicit Transaction(Database& database);
+  ~Transaction();
+  Transaction(const Transaction&) = delete;
+  Transaction& operator=(const Transaction&) = delete;
+  void commit();
+
+ private:
+  Database& m_database;
+  bool m_done = false;
+};
+
+}  // namespace balloon::store

@@ -1,0 +1,268 @@
+#include "store/job_store.hpp"
+
+namespace balloon::store {
+namespace {
+
+constexpr const char* INSERT_JOB =
+    "INSERT INTO jobs (job_id, owner, kind, state, priority, spec, summary, created_ms) "
+    "VALUES (?, ?, ?, ?, ?, ?, ?, ?)";
+
+// The latest progress row of each job joins in through its maximum id (index progress_job).
+#define JOB_COLUMNS                                                                                     \
+  "jobs.id, jobs.job_id, jobs.owner, jobs.kind, jobs.state, jobs.priority, jobs.spec, jobs.summary, "  \
+  "jobs.error, jobs.converged, jobs.created_ms, jobs.started_ms, jobs.finished_ms, jobs.attempts, "     \
+  "p.phase, p.iteration, p.elapsed_s, p.residual_norm, p.pressure_kpa, p.avg_error_mm, p.max_error_mm, " \
+  "p.recorded_ms "
+#define JOB_FROM                                                                                        \
+  "FROM jobs LEFT JOIN progress AS p ON p.id = "                                                        \
+  "(SELECT MAX(id) FROM progress WHERE progress.job_row = jobs.id) "
+
+constexpr const char* SELECT_JOB_BY_ID = "SELECT " JOB_COLUMNS JOB_FROM "WHERE jobs.job_id = ?";
+constexpr const char* SELECT_JOB_BY_ROW = "SELECT " JOB_COLUMNS JOB_FROM "WHERE jobs.id = ?";
+constexpr const char* SELECT_JOBS_PAGE =
+    "SELECT " JOB_COLUMNS JOB_FROM
+    "WHERE jobs.owner = ? AND jobs.id < ? AND (? = '' OR jobs.state = ?) ORDER BY jobs.id DESC LIMIT ?";
+constexpr const char* SELECT_QUEUED_JOBS =
+    "SELECT " JOB_COLUMNS JOB_FROM "WHERE jobs.state = 'queued' ORDER BY jobs.priority DESC, jobs.id ASC";
+
+constexpr const char* MARK_RUNNING =
+    "UPDATE jobs SET state = 'running', attempts = attempts + 1, started_ms = ? "
+    "WHERE id = ? AND state = 'queued'";
+constexpr const char* MARK_CANCELLED =
+    "UPDATE jobs SET state = 'cancelled', error = ?, finished_ms = ? "
+    "WHERE id = ? AND state IN ('queued', 'running')";
+constexpr const char* MARK_REQUEUED = "UPDATE jobs SET state = 'queued' WHERE id = ? AND state = 'running'";
+constexpr const char* REQUEUE_ALL_RUNNING = "UPDATE jobs SET state = 'queued' WHERE state = 'running'";
+constexpr const char* MARK_COMPLETED =
+    "UPDATE jobs SET state = 'completed', converged = ?, finished_ms = ?, error = '' "
+    "WHERE id = ? AND state = 'running'";
+constexpr const char* MARK_FAILED =
+    "UPDATE jobs SET state = 'failed', error = ?, finished_ms = ? WHERE id = ? AND state IN ('queued', 'running')";
+
+constexpr const char* INSERT_RESULT =
+    "INSERT OR REPLACE INTO results (job_row, converged, rest_mesh, inflated_mesh, report_json, created_ms) "
+    "VALUES (?, ?, ?, ?, ?, ?)";
+constexpr const char* SELECT_RESULT =
+    "SELECT converged, rest_mesh, inflated_mesh, report_json, created_ms FROM results WHERE job_row = ?";
+
+constexpr const char* CLEAR_OLD_SHAPES =
+    "UPDATE progress SET shape = NULL WHERE job_row = ? AND shape IS NOT NULL";
+constexpr const char* INSERT_PROGRESS =
+    "INSERT INTO progress (job_row, phase, iteration, elapsed_s, residual_norm, pressure_kpa, avg_error_mm, "
+    "max_error_mm, recorded_ms, shape) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)";
+constexpr const char* SELECT_LATEST_SHAPE =
+    "SELECT shape FROM progress WHERE job_row = ? AND shape IS NOT NULL ORDER BY id DESC LIMIT 1";
+constexpr const char* COUNT_PROGRESS = "SELECT COUNT(*) FROM progress WHERE job_row = ?";
+
+#undef JOB_COLUMNS
+#undef JOB_FROM
+
+JobRecord read_job(const Statement& row) {
+  JobRecord job;
+  job.row_id = row.column_int64(0);
+  job.job_id = row.column_text(1);
+  job.owner = row.column_text(2);
+  job.kind = row.column_text(3);
+  job.state = job_state_from_string(row.column_text(4));
+  job.priority = row.column_int(5);
+  job.spec = row.column_blob(6);
+  job.summary = row.column_text(7);
+  job.error = row.column_text(8);
+  job.converged = row.column_int(9) != 0;
+  job.created_ms = row.column_int64(10);
+  job.started_ms = row.column_int64(11);
+  job.finished_ms = row.column_int64(12);
+  job.attempts = row.column_int(13);
+  if (!row.column_is_null(14)) {
+    ProgressRecord progress;
+    progress.phase = row.column_text(14);
+    progress.iteration = row.column_int(15);
+    progress.elapsed_s = row.column_double(16);
+    progress.residual_norm = row.column_double(17);
+    progress.pressure_kpa = row.column_double(18);
+    progress.avg_error_mm = row.column_double(19);
+    progress.max_error_mm = row.column_double(20);
+    progress.recorded_ms = row.column_int64(21);
+    job.last_progress = progress;
+  }
+  return job;
+}
+
+}  // namespace
+
+const char* to_string(JobState state) {
+  switch (state) {
+    case JobState::Queued: return "queued";
+    case JobState::Running: return "running";
+    case JobState::Completed: return "completed";
+    case JobState::Failed: return "failed";
+    case JobState::Cancelled: return "cancelled";
+  }
+  return "queued";
+}
+
+JobState job_state_from_string(const std::string& text) {
+  for (JobState state : {JobState::Queued, JobState::Running, JobState::Completed, JobState::Failed,
+                         JobState::Cancelled})
+    if (text == to_string(state)) return state;
+  throw DatabaseError("unknown job state '" + text + "' in the store");
+}
+
+void JobStore::insert(JobRecord& job) {
+  std::lock_guard lock(m_store.mutex());
+  Statement statement = m_store.database().prepare(INSERT_JOB);
+  statement.bind(1, job.job_id)
+      .bind(2, job.owner)
+      .bind(3, job.kind)
+      .bind(4, to_string(job.state))
+      .bind(5, job.priority)
+      .bind_blob(6, job.spec)
+      .bind(7, job.summary)
+      .bind(8, job.created_ms);
+  statement.run();
+  job.row_id = m_store.database().last_insert_id();
+}
+
+std::optional<JobRecord> JobStore::find(const std::string& job_id) {
+  std::lock_guard lock(m_store.mutex());
+  Statement statement = m_store.database().prepare(SELECT_JOB_BY_ID);
+  statement.bind(1, job_id);
+  if (!statement.step()) return std::nullopt;
+  return read_job(statement);
+}
+
+std::optional<JobRecord> JobStore::find_row(std::int64_t row_id) {
+  std::lock_guard lock(m_store.mutex());
+  Statement statement = m_store.database().prepare(SELECT_JOB_BY_ROW);
+  statement.bind(1, row_id);
+  if (!statement.step()) return std::nullopt;
+  return read_job(statement);
+}
+
+JobPage JobStore::list(const std::string& owner, std::optional<JobState> state, std::int64_t before_row, int limit) {
+  std::lock_guard lock(m_store.mutex());
+  Statement statement = m_store.database().prepare(SELECT_JOBS_PAGE);
+  const std::string state_text = state ? to_string(*state) : "";
+  // One more row than asked tells whether another page follows.
+  statement.bind(1, owner)
+      .bind(2, before_row > 0 ? before_row : INT64_MAX)
+      .bind(3, state_text)
+      .bind(4, state_text)
+      .bind(5, limit + 1);
+  JobPage page;
+  while (statement.step()) page.jobs.push_back(read_job(statement));
+  if (static_cast<int>(page.jobs.size()) > limit) {
+    page.jobs.resize(static_cast<std::size_t>(limit));
+    page.next_before_row = page.jobs.back().row_id;
+  }
+  return page;
+}
+
+bool JobStore::mark_running(std::int64_t row_id) {
+  std::lock_guard lock(m_store.mutex());
+  Statement statement = m_store.database().prepare(MARK_RUNNING);
+  statement.bind(1, now_ms()).bind(2, row_id).run();
+  return m_store.database().changes() == 1;
+}
+
+bool JobStore::mark_cancelled(std::int64_t row_id, const std::string& reason) {
+  std::lock_guard lock(m_store.mutex());
+  Statement statement = m_store.database().prepare(MARK_CANCELLED);
+  statement.bind(1, reason).bind(2, now_ms()).bind(3, row_id).run();
+  return m_store.database().changes() == 1;
+}
+
+void JobStore::mark_requeued(std::int64_t row_id) {
+  std::lock_guard lock(m_store.mutex());
+  m_store.database().prepare(MARK_REQUEUED).bind(1, row_id).run();
+}
+
+bool JobStore::mark_completed(std::int64_t row_id, const ResultRecord& result) {
+  std::lock_guard lock(m_store.mutex());
+  Transaction transaction(m_store.database());
+  const std::int64_t now = now_ms();
+  m_store.database().prepare(MARK_COMPLETED).bind(1, result.converged ? 1 : 0).bind(2, now).bind(3, row_id).run();
+  if (m_store.database().changes() != 1) return false;  // the transaction rolls back
+  m_store.database()
+      .prepare(INSERT_RESULT)
+      .bind(1, row_id)
+      .bind(2, result.converged ? 1 : 0)
+      .bind_blob(3, result.rest_mesh)
+      .bind_blob(4, result.inflated_mesh)
+      .bind(5, result.report_json)
+      .bind(6, now)
+      .run();
+  transaction.commit();
+  return true;
+}
+
+void JobStore::mark_failed(std::int64_t row_id, const std::string& error) {
+  std::lock_guard lock(m_store.mutex());
+  m_store.database().prepare(MARK_FAILED).bind(1, error).bind(2, now_ms()).bind(3, row_id).run();
+}
+
+void JobStore::append_progress(std::int64_t row_id, const ProgressRecord& progress, const std::string& shape) {
+  std::lock_guard lock(m_store.mutex());
+  Transaction transaction(m_store.database());
+  if (!shape.empty()) m_store.database().prepare(CLEAR_OLD_SHAPES).bind(1, row_id).run();
+  Statement statement = m_store.database().prepare(INSERT_PROGRESS);
+  statement.bind(1, row_id)
+      .bind(2, progress.phase)
+      .bind(3, progress.iteration)
+      .bind(4, progress.elapsed_s)
+      .bind(5, progress.residual_norm)
+      .bind(6, progress.pressure_kpa)
+      .bind(7, progress.avg_error_mm)
+      .bind(8, progress.max_error_mm)
+      .bind(9, progress.recorded_ms);
+  if (shape.empty())
+    statement.bind_null(10);
+  else
+    statement.bind_blob(10, shape);
+  statement.run();
+  transaction.commit();
+}
+
+std::optional<std::string> JobStore::latest_shape(std::int64_t row_id) {
+  std::lock_guard lock(m_store.mutex());
+  Statement statement = m_store.database().prepare(SELECT_LATEST_SHAPE);
+  statement.bind(1, row_id);
+  if (!statement.step()) return std::nullopt;
+  return statement.column_blob(0);
+}
+
+int JobStore::progress_count(std::int64_t row_id) {
+  std::lock_guard lock(m_store.mutex());
+  Statement statement = m_store.database().prepare(COUNT_PROGRESS);
+  statement.bind(1, row_id);
+  return statement.step() ? statement.column_int(0) : 0;
+}
+
+std::optional<ResultRecord> JobStore::result(std::int64_t row_id) {
+  std::lock_guard lock(m_store.mutex());
+  Statement statement = m_store.database().prepare(SELECT_RESULT);
+  statement.bind(1, row_id);
+  if (!statement.step()) return std::nullopt;
+  ResultRecord result;
+  result.converged = statement.column_int(0) != 0;
+  result.rest_mesh = statement.column_blob(1);
+  result.inflated_mesh = statement.column_blob(2);
+  result.report_json = statement.column_text(3);
+  result.created_ms = statement.column_int64(4);
+  return result;
+}
+
+std::vector<JobRecord> JobStore::recover_unfinished() {
+  std::lock_guard lock(m_store.mutex());
+  Transaction transaction(m_store.database());
+  m_store.database().execute(REQUEUE_ALL_RUNNING);
+  std::vector<JobRecord> jobs;
+  {
+    Statement statement = m_store.database().prepare(SELECT_QUEUED_JOBS);
+    while (statement.step()) jobs.push_back(read_job(statement));
+  }
+  transaction.commit();
+  return jobs;
+}
+
+}  // namespace balloon::store

@@ -1,0 +1,100 @@
+#include "store/schema.hpp"
+
+#include <string>
+#include <vector>
+
+#include "store/database.hpp"
+
+namespace balloon::store {
+namespace {
+
+// Version 1: jobs, their progress checkpoints, their results, and the tenants' materials.
+constexpr const char* MIGRATION_1 = R"sql(
+CREATE TABLE jobs (
+  id INTEGER PRIMARY KEY,
+  job_id TEXT NOT NULL UNIQUE,
+  owner TEXT NOT NULL,
+  kind TEXT NOT NULL,
+  state TEXT NOT NULL CHECK (state IN ('queued', 'running', 'completed', 'failed', 'cancelled')),
+  priority INTEGER NOT NULL DEFAULT 0,
+  spec BLOB NOT NULL,
+  summary TEXT NOT NULL DEFAULT '',
+  error TEXT NOT NULL DEFAULT '',
+  converged INTEGER NOT NULL DEFAULT 0,
+  created_ms INTEGER NOT NULL,
+  started_ms INTEGER NOT NULL DEFAULT 0,
+  finished_ms INTEGER NOT NULL DEFAULT 0,
+  attempts INTEGER NOT NULL DEFAULT 0
+);
+CREATE INDEX jobs_owner_id ON jobs (owner, id);
+CREATE INDEX jobs_state ON jobs (state, priority, id);
+
+CREATE TABLE progress (
+  id INTEGER PRIMARY KEY,
+  job_row INTEGER NOT NULL REFERENCES jobs (id) ON DELETE CASCADE,
+  phase TEXT NOT NULL,
+  iteration INTEGER NOT NULL,
+  elapsed_s REAL NOT NULL,
+  residual_norm REAL NOT NULL,
+  pressure_kpa REAL NOT NULL,
+  avg_error_mm REAL NOT NULL,
+  max_error_mm REAL NOT NULL,
+  recorded_ms INTEGER NOT NULL,
+  shape BLOB
+);
+CREATE INDEX progress_job ON progress (job_row, id);
+
+CREATE TABLE results (
+  job_row INTEGER PRIMARY KEY REFERENCES jobs (id) ON DELETE CASCADE,
+  converged INTEGER NOT NULL,
+  rest_mesh BLOB NOT NULL,
+  inflated_mesh BLOB NOT NULL,
+  report_json TEXT NOT NULL,
+  created_ms INTEGER NOT NULL
+);
+
+CREATE TABLE materials (
+  id INTEGER PRIMARY KEY,
+  owner TEXT NOT NULL,
+  name TEXT NOT NULL,
+  spec TEXT NOT NULL,
+  description TEXT NOT NULL DEFAULT '',
+  created_ms INTEGER NOT NULL,
+  updated_ms INTEGER NOT NULL,
+  UNIQUE (owner, name)
+);
+)sql";
+
+const std::vector<const char*>& migrations() {
+  static const std::vector<const char*> list = {MIGRATION_1};
+  return list;
+}
+
+int user_version(Database& database) {
+  Statement statement = database.prepare("PRAGMA user_version");
+  return statement.step() ? statement.column_int(0) : 0;
+}
+
+}  // namespace
+
+int current_schema_version() { return static_cast<int>(migrations().size()); }
+
+void migrate(Database& database) {
+  const int target = current_schema_version();
+  int version = user_version(database);
+  if (version > target)
+    throw DatabaseError("database '" + database.path() + "' has schema version " + std::to_string(version) +
+                        ", newer than this build's " + std::to_string(target));
+  while (version < target) {
+    Transaction transaction(database);
+    // Re-read inside the write lock: another process may have migrated meanwhile.
+    version = user_version(database);
+    if (version >= target) break;
+    database.execute(migrations()[static_cast<std::size_t>(version)]);
+    database.execute("PRAGMA user_version = " + std::to_string(version + 1));
+    transaction.commit();
+    ++version;
+  }
+}
+
+}  // namespace balloon::store

@@ -1,0 +1,114 @@
+#include "mesh/mesh_geometry.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "core/mesh/mesh_test_helpers.hpp"
+#include "mesh/icosphere.hpp"
+#include "mesh/mesh_io.hpp"
+
+namespace balloon {
+namespace {
+
+using test::unit_cube;
+
+TEST(MeshGeometry, UnitCubeMeasures) {
+  const TriMesh cube = unit_cube();
+  EXPECT_NEAR(enclosed_volume(cube.vertices, cube.faces), 1.0, 1e-15);
+  EXPECT_NEAR(surface_area(cube.vertices, cube.faces), 6.0, 1e-14);
+  EXPECT_NEAR(bounding_box_diagonal(cube.vertices), std::sqrt(3.0), 1e-15);
+  EXPECT_TRUE(centroid(cube.vertices).isApprox(Eigen::RowVector3d(0.5, 0.5, 0.5), 1e-15));
+  EXPECT_NEAR(min_angle_deg(cube.vertices, cube.faces), 45.0, 1e-12);
+}
+
+TEST(MeshGeometry, VolumeIsSignedAndTranslationInvariant) {
+  TriMesh cube = unit_cube();
+  cube.vertices.rowwise() += Eigen::RowVector3d(100.0, -50.0, 3.0);
+  EXPECT_NEAR(enclosed_volume(cube.vertices, cube.faces), 1.0, 1e-9);
+  cube.faces.col(1).swap(cube.faces.col(2));
+  EXPECT_NEAR(enclosed_volume(cube.vertices, cube.faces), -1.0, 1e-9);
+  EXPECT_NEAR(surface_area(cube.vertices, cube.faces), 6.0, 1e-12);
+}
+
+TEST(MeshGeometry, EmptyInputs) {
+  const Positions none(0, 3);
+  EXPECT_EQ(bounding_box_diagonal(none), 0.0);
+  EXPECT_TRUE(centroid(none).isZero());
+  EXPECT_EQ(min_angle_deg(none, Faces(0, 3)), 180.0);
+  EXPECT_EQ(enclosed_volume(none, Faces(0, 3)), 0.0);
+}
+
+TEST(MeshGeometry, MinAngleOfSampleMeshesMatchesProvenance) {
+  // Minimum angles (degrees) stated in tests/data/meshes/PROVENANCE.md, rounded there.
+  const std::pair<const char*, double> expected[] = {
+      {"hand_fist.off", 0.69}, {"cube_866.off", 45.0}, {"retinal_bumpy_blob.off", 1.13},
+      {"icosphere_812.off", 54.1}, {"spot.obj", 10.2}, {"stanford_bunny_1839.obj", 13.2}};
+  for (const auto& [name, angle] : expected) {
+    const auto mesh = read_mesh(test::sample_mesh(name));
+    ASSERT_TRUE(mesh.ok()) << mesh.error();
+    EXPECT_NEAR(min_angle_deg(mesh->vertices, mesh->faces), angle, 0.01 + 0.005 * angle) << name;
+  }
+}
+
+TEST(MeshEdgeTopology, ClosedIcosphereHasTwoFacesPerEdge) {
+  const TriMesh mesh = make_icosphere(5.0, 3);
+  const EdgeTopology topology = build_edge_topology(mesh.faces, mesh.vertex_count());
+  const auto edge_count = topology.edges.rows();
+  ASSERT_EQ(edge_count * 2, mesh.face_count() * 3);  // E = 3F/2
+  EXPECT_EQ(mesh.vertex_count() - edge_count + mesh.face_count(), 2);  // Euler, genus 0
+  for (Eigen::Index e = 0; e < edge_count; ++e) {
+    const int a = topology.edges(e, 0), b = topology.edges(e, 1);
+    for (int k = 0; k < 2; ++k) {
+      const int f = topology.edge_faces(e, k);
+      ASSERT_GE(f, 0) << "edge " << e << " lacks a face";
+      // Face 0 runs a -> b, face 1 runs b -> a (consistent orientation); the opposite vertex closes it.
+      const int from = k == 0 ? a : b, to = k == 0 ? b : a;
+      const int opposite = topology.edge_opposite(e, k);
+      bool found = false;
+      for (int c = 0; c < 3; ++c) {
+        found |= mesh.faces(f, c) == from && mesh.faces(f, (c + 1) % 3) == to &&
+                 mesh.faces(f, (c + 2) % 3) == opposite;
+      }
+      ASSERT_TRUE(found) << "edge " << e << " side " << k;
+    }
+    EXPECT_NE(topology.edge_faces(e, 0), topology.edge_faces(e, 1));
+  }
+  for (int f = 0; f < mesh.face_count(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const int e = topology.face_edges(f, k);
+      const int p = mesh.faces(f, (k + 1) % 3), q = mesh.faces(f, (k + 2) % 3);
+      ASSERT_EQ(std::minmax(p, q), std::minmax(topology.edges(e, 0), topology.edges(e, 1)));
+    }
+  }
+}
+
+TEST(MeshEdgeTopology, OpenMeshHasBoundaryEdges) {
+  TriMesh mesh = make_icosphere(5.0, 1);
+  const Faces all = mesh.faces;
+  mesh.faces = all.bottomRows(all.rows() - 1);  // remove face 0: a triangular hole
+  const EdgeTopology topology = build_edge_topology(mesh.faces, mesh.vertex_count());
+  int boundary = 0;
+  for (Eigen::Index e = 0; e < topology.edges.rows(); ++e) {
+    if (topology.edge_faces(e, 1) < 0) {
+      ++boundary;
+      EXPECT_EQ(topology.edge_opposite(e, 1), -1);
+      EXPECT_GE(topology.edge_faces(e, 0), 0);
+    }
+  }
+  EXPECT_EQ(boundary, 3);
+  EXPECT_EQ(topology.edges.rows(), 120);  // edges are not lost with the face
+}
+
+TEST(MeshEdgeTopology, RejectsNonManifoldEdgesAndBadIndices) {
+  TriMesh mesh = make_icosphere(5.0, 1);
+  Faces more(mesh.face_count() + 1, 3);
+  more << mesh.faces, mesh.faces(0, 0), mesh.faces(0, 1), mesh.faces(5, 2);
+  EXPECT_THROW(build_edge_topology(more, mesh.vertex_count()), std::invalid_argument);
+  EXPECT_THROW(build_edge_topology(mesh.faces, mesh.vertex_count() - 1), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace balloon

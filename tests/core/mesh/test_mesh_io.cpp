@@ -1,0 +1,531 @@
+#include "mesh/mesh_io.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/mesh/mesh_test_helpers.hpp"
+#include "mesh/icosphere.hpp"
+#include "mesh/mesh_checks.hpp"
+#include "mesh/mesh_geometry.hpp"
+
+namespace balloon {
+namespace {
+
+using test::offset_icosphere;
+using test::same_geometry;
+using test::sample_mesh;
+using test::TemporaryDirectory;
+
+void expect_contains(const std::string& message, std::initializer_list<std::string> fragments) {
+  for (const auto& fragment : fragments) {
+    EXPECT_NE(message.find(fragment), std::string::npos) << "message '" << message << "' lacks '" << fragment << "'";
+  }
+  EXPECT_EQ(message.find('\n'), std::string::npos) << "message spans lines: " << message;
+}
+
+void write_file(const std::string& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  ASSERT_TRUE(out.good()) << path;
+}
+
+// ------------------------------------------------------------------------------------------------
+// Fixture writers for formats we read but do not write.
+
+std::string base64(const std::string& bytes) {
+  static const char* const alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    std::uint32_t chunk = static_cast<unsigned char>(bytes[i]) << 16;
+    if (i + 1 < bytes.size()) chunk |= static_cast<unsigned char>(bytes[i + 1]) << 8;
+    if (i + 2 < bytes.size()) chunk |= static_cast<unsigned char>(bytes[i + 2]);
+    out += alphabet[(chunk >> 18) & 63];
+    out += alphabet[(chunk >> 12) & 63];
+    out += i + 1 < bytes.size() ? alphabet[(chunk >> 6) & 63] : '=';
+    out += i + 2 < bytes.size() ? alphabet[chunk & 63] : '=';
+  }
+  return out;
+}
+
+/// Float positions then uint32 indices, little-endian, as one glTF buffer.
+std::string gltf_buffer(const TriMesh& mesh) {
+  std::string bytes;
+  auto append = [&bytes](const void* data, std::size_t size) {
+    bytes.append(static_cast<const char*>(data), size);
+  };
+  for (int v = 0; v < mesh.vertex_count(); ++v) {
+    for (int k = 0; k < 3; ++k) {
+      const auto value = static_cast<float>(mesh.vertices(v, k));
+      append(&value, 4);
+    }
+  }
+  for (int f = 0; f < mesh.face_count(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const auto index = static_cast<std::uint32_t>(mesh.faces(f, k));
+      append(&index, 4);
+    }
+  }
+  return bytes;
+}
+
+/// A glTF 2.0 document with one mesh instanced by `nodes_json` (a JSON array of nodes, all listed in
+/// the scene). `buffer_uri` empty means a GLB's binary chunk.
+std::string gltf_json(const TriMesh& mesh, const std::string& nodes_json, int node_count,
+                      const std::string& buffer_uri) {
+  const std::size_t positions_bytes = static_cast<std::size_t>(mesh.vertex_count()) * 12;
+  const std::size_t indices_bytes = static_cast<std::size_t>(mesh.face_count()) * 12;
+  const Eigen::RowVector3f lo = mesh.vertices.colwise().minCoeff().cast<float>();
+  const Eigen::RowVector3f hi = mesh.vertices.colwise().maxCoeff().cast<float>();
+  // A stream rather than operator+ chains: GCC 12 warns falsely (-Wrestrict) on "..." + std::string.
+  std::ostringstream json;
+  json.precision(9);
+  json << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[)";
+  for (int i = 0; i < node_count; ++i) json << (i ? "," : "") << i;
+  json << R"(]}],"nodes":)" << nodes_json
+       << R"(,"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1,"mode":4}]}],)"
+       << R"("buffers":[{"byteLength":)" << positions_bytes + indices_bytes;
+  if (!buffer_uri.empty()) json << R"(,"uri":")" << buffer_uri << '"';
+  json << R"(}],"bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":)" << positions_bytes
+       << R"(,"target":34962},{"buffer":0,"byteOffset":)" << positions_bytes << R"(,"byteLength":)"
+       << indices_bytes << R"(,"target":34963}],)"
+       << R"("accessors":[{"bufferView":0,"componentType":5126,"count":)" << mesh.vertex_count()
+       << R"(,"type":"VEC3","min":[)" << lo(0) << ',' << lo(1) << ',' << lo(2) << R"(],"max":[)" << hi(0)
+       << ',' << hi(1) << ',' << hi(2) << R"(]},{"bufferView":1,"componentType":5125,"count":)"
+       << 3 * mesh.face_count() << R"(,"type":"SCALAR"}]})";
+  return json.str();
+}
+
+std::string gltf_embedded(const TriMesh& mesh, const std::string& nodes_json, int node_count) {
+  return gltf_json(mesh, nodes_json, node_count,
+                   "data:application/octet-stream;base64," + base64(gltf_buffer(mesh)));
+}
+
+std::string glb(const TriMesh& mesh, const std::string& nodes_json, int node_count) {
+  std::string json = gltf_json(mesh, nodes_json, node_count, "");
+  std::string bin = gltf_buffer(mesh);
+  json.resize((json.size() + 3) / 4 * 4, ' ');
+  bin.resize((bin.size() + 3) / 4 * 4, '\0');
+  std::string out;
+  auto u32 = [&out](std::uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
+  out += "glTF";
+  u32(2);
+  u32(static_cast<std::uint32_t>(12 + 8 + json.size() + 8 + bin.size()));
+  u32(static_cast<std::uint32_t>(json.size()));
+  out += "JSON";
+  out += json;
+  u32(static_cast<std::uint32_t>(bin.size()));
+  out += std::string("BIN\0", 4);
+  out += bin;
+  return out;
+}
+
+std::string ascii_stl(const TriMesh& mesh) {
+  std::string out = "solid fixture\n";
+  for (int f = 0; f < mesh.face_count(); ++f) {
+    out += " facet normal 0 0 0\n  outer loop\n";
+    for (int k = 0; k < 3; ++k) {
+      const auto p = mesh.vertices.row(mesh.faces(f, k)).cast<float>();
+      char line[128];
+      std::snprintf(line, sizeof line, "   vertex %.9g %.9g %.9g\n", p(0), p(1), p(2));
+      out += line;
+    }
+    out += "  endloop\n endfacet\n";
+  }
+  return out + "endsolid fixture\n";
+}
+
+std::string ascii_ply(const TriMesh& mesh, int quad_face = -1) {
+  std::string out = "ply\nformat ascii 1.0\nelement vertex " + std::to_string(mesh.vertex_count()) +
+                    "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+                    std::to_string(mesh.face_count()) + "\nproperty list uchar int vertex_indices\nend_header\n";
+  char line[128];
+  for (int v = 0; v < mesh.vertex_count(); ++v) {
+    std::snprintf(line, sizeof line, "%.9g %.9g %.9g\n", mesh.vertices(v, 0), mesh.vertices(v, 1),
+                  mesh.vertices(v, 2));
+    out += line;
+  }
+  for (int f = 0; f < mesh.face_count(); ++f) {
+    if (f == quad_face) {
+      out += "4 " + std::to_string(mesh.faces(f, 0)) + " " + std::to_string(mesh.faces(f, 1)) + " " +
+             std::to_string(mesh.faces(f, 2)) + " " + std::to_string(mesh.faces((f + 1) % mesh.face_count(), 0)) + "\n";
+    } else {
+      out += "3 " + std::to_string(mesh.faces(f, 0)) + " " + std::to_string(mesh.faces(f, 1)) + " " +
+             std::to_string(mesh.faces(f, 2)) + "\n";
+    }
+  }
+  return out;
+}
+
+// ------------------------------------------------------------------------------------------------
+// Sample meshes.
+
+struct SampleMesh {
+  const char* name;
+  int vertices;
+  int faces;
+};
+
+// Counts from tests/data/meshes/PROVENANCE.md.
+const SampleMesh SAMPLE_MESHES[] = {
+    {"stanford_bunny_1839.obj", 1839, 3674}, {"teddy_bear.off", 13826, 27648},
+    {"hand_fist.off", 1197, 2390},           {"cube_866.off", 866, 1728},
+    {"retinal_bumpy_blob.off", 3643, 7282},  {"icosphere_812.off", 812, 1620},
+    {"spot.obj", 2930, 5856}};
+
+TEST(MeshIo, EverySampleMeshLoadsAndValidates) {
+  for (const SampleMesh& sample : SAMPLE_MESHES) {
+    SCOPED_TRACE(sample.name);
+    auto mesh = read_mesh(sample_mesh(sample.name));
+    ASSERT_TRUE(mesh.ok()) << mesh.error();
+    EXPECT_EQ(mesh->vertex_count(), sample.vertices);
+    EXPECT_EQ(mesh->face_count(), sample.faces);
+    const TriMesh before = *mesh;
+    const auto report = validate_balloon_mesh(*mesh);
+    ASSERT_TRUE(report.ok()) << report.error();
+    EXPECT_FALSE(report->flipped);  // all are oriented outwards
+    EXPECT_EQ(report->removed_unreferenced_vertices, 0);
+    EXPECT_EQ(report->vertices, sample.vertices);
+    EXPECT_EQ(report->faces, sample.faces);
+    EXPECT_EQ(report->genus, 0);
+    EXPECT_GT(report->volume_mm3, 0.0);
+    EXPECT_EQ(mesh->vertices, before.vertices);
+    EXPECT_EQ(mesh->faces, before.faces);
+  }
+}
+
+TEST(MeshIo, ObjKeepsFileOrderAndDigits) {
+  // spot.obj: first line "v 0.348799 -0.334989 -0.0832331", first face "f 739/1 735/2 736/3".
+  const auto spot = read_mesh(sample_mesh("spot.obj"));
+  ASSERT_TRUE(spot.ok()) << spot.error();
+  EXPECT_EQ(spot->vertices.row(0), Eigen::RowVector3d(0.348799, -0.334989, -0.0832331));
+  EXPECT_EQ(spot->faces.row(0), Eigen::RowVector3i(738, 734, 735));
+}
+
+TEST(MeshIo, OffKeepsDoublePrecision) {
+  // icosphere_812.off: first vertex "-0.52573111211913348 0.85065080835203999 -2.5720446970240305e-18".
+  const auto sphere = read_mesh(sample_mesh("icosphere_812.off"));
+  ASSERT_TRUE(sphere.ok()) << sphere.error();
+  EXPECT_EQ(sphere->vertices(0, 0), -0.52573111211913348);
+  EXPECT_EQ(sphere->vertices(0, 2), -2.5720446970240305e-18);
+}
+
+TEST(MeshIo, ObjVariantsParse) {
+  // Negative (relative) references, v/vt/vn forms, comments, CRLF, tabs, ignored statements.
+  const std::string obj =
+      "# tetrahedron\r\nmtllib x.mtl\r\nv 0 0 0\r\nv 1 0 0\r\nv\t0 1 0\r\nv 0 0 1 1.0\r\nvt 0 0\r\nvn 0 0 1\r\n"
+      "o thing\r\ng group\r\ns off\r\nusemtl m\r\nf 1 3 2\r\nf 1//1 2//1 4//1\r\nf 2/1/1 3/1/1 4/1/1\r\n"
+      "f -4 -1 -2 # last\r\nl 1 2\r\n";
+  auto mesh = read_mesh_from_memory(obj, "OBJ");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  ASSERT_EQ(mesh->vertex_count(), 4);
+  ASSERT_EQ(mesh->face_count(), 4);
+  EXPECT_EQ(mesh->faces.row(3), Eigen::RowVector3i(0, 3, 2));
+  const auto report = validate_balloon_mesh(*mesh);
+  ASSERT_TRUE(report.ok()) << report.error();
+  EXPECT_FALSE(report->flipped);
+  EXPECT_NEAR(report->volume_mm3, 1.0 / 6.0, 1e-15);
+}
+
+TEST(MeshIo, RoundTripsThroughObjStlAndPly) {
+  const TriMesh original = offset_icosphere(2);
+  TemporaryDirectory dir;
+  for (const char* format : {"obj", "stl", "ply"}) {
+    SCOPED_TRACE(format);
+    const std::string path = dir.file(std::string("sphere.") + format);
+    const auto written = write_mesh(original, path);
+    ASSERT_TRUE(written.ok()) << written.error();
+    const auto back = read_mesh(path);
+    ASSERT_TRUE(back.ok()) << back.error();
+    // The STL is a soup of 3 * 320 corners; welding must give back the 162 shared vertices.
+    EXPECT_TRUE(same_geometry(original, *back, 1e-6));
+    EXPECT_NEAR(enclosed_volume(back->vertices, back->faces) / enclosed_volume(original.vertices, original.faces),
+                1.0, 1e-6);
+    if (std::string(format) != "stl") {  // indexed formats keep the vertex order
+      EXPECT_EQ(back->faces, original.faces);
+      EXPECT_LT((back->vertices - original.vertices).cwiseAbs().maxCoeff(), 1e-6 * 50.0);
+    }
+    TriMesh copy = *back;
+    const auto report = validate_balloon_mesh(copy);
+    ASSERT_TRUE(report.ok()) << report.error();
+    EXPECT_FALSE(report->flipped);
+    EXPECT_EQ(report->vertices, 162);
+    EXPECT_EQ(dir.entry_count(), 1) << "temporary file left behind";
+    std::filesystem::remove(path);
+  }
+}
+
+TEST(MeshIo, StlWeldingGivesAClosedMesh) {
+  const TriMesh original = make_icosphere(10.0, 3);
+  auto soup = read_mesh_from_memory(write_mesh_to_memory(original, "stl"), "stl");
+  ASSERT_TRUE(soup.ok()) << soup.error();
+  EXPECT_EQ(soup->vertex_count(), 642);
+  EXPECT_EQ(soup->face_count(), 1280);
+  const auto report = validate_balloon_mesh(*soup);
+  ASSERT_TRUE(report.ok()) << report.error();
+  EXPECT_EQ(report->edges, 1920);
+}
+
+TEST(MeshIo, WritingIsDeterministicAndObjUsesNineDigits) {
+  const TriMesh mesh = offset_icosphere(1);
+  for (const char* format : {"obj", "stl", "ply"}) {
+    EXPECT_EQ(write_mesh_to_memory(mesh, format), write_mesh_to_memory(mesh, format)) << format;
+  }
+  TriMesh one;
+  one.vertices.resize(3, 3);
+  one.vertices << 1.0 / 3.0, 0, 0, 0, 1, 0, 0, 0, 12345.678901234;
+  one.faces.resize(1, 3);
+  one.faces << 0, 1, 2;
+  const std::string obj = write_mesh_to_memory(one, "obj");
+  EXPECT_NE(obj.find("v 0.333333333 0 0\n"), std::string::npos) << obj;
+  EXPECT_NE(obj.find("v 0 0 12345.6789\n"), std::string::npos) << obj;
+  EXPECT_NE(obj.find("f 1 2 3\n"), std::string::npos) << obj;
+  const std::string stl = write_mesh_to_memory(one, "stl");
+  EXPECT_EQ(stl.size(), 80u + 4u + 50u);
+  EXPECT_NE(stl.substr(0, 5), "solid");
+}
+
+TEST(MeshIo, ReadsAsciiStlWithUpperCaseExtension) {
+  const TriMesh original = offset_icosphere(1);
+  const std::string text = ascii_stl(original);
+  auto from_memory = read_mesh_from_memory(text, "stl");
+  ASSERT_TRUE(from_memory.ok()) << from_memory.error();
+  EXPECT_TRUE(same_geometry(original, *from_memory, 1e-6));
+  TemporaryDirectory dir;
+  write_file(dir.file("sphere.STL"), text);
+  auto from_file = read_mesh(dir.file("sphere.STL"));
+  ASSERT_TRUE(from_file.ok()) << from_file.error();
+  EXPECT_EQ(from_file->vertex_count(), 42);
+  EXPECT_TRUE(validate_balloon_mesh(*from_file).ok());
+}
+
+TEST(MeshIo, StlWeldsSignedZerosAndOnlyExactDuplicates) {
+  // A tetrahedron whose origin corner is written once as -0: it must still weld. Vertex 3 has a
+  // near-duplicate 1e-7 away (a distinct point): it must not weld.
+  const std::string stl =
+      "solid t\n"
+      "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 1 0\nvertex 1 0 0\nendloop\nendfacet\n"
+      "facet normal 0 0 0\nouter loop\nvertex -0 0 -0\nvertex 1 0 0\nvertex 0 0 1\nendloop\nendfacet\n"
+      "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 0 1\nvertex 0 1 0\nendloop\nendfacet\n"
+      "facet normal 0 0 0\nouter loop\nvertex 1 0 0\nvertex 0 1 0\nvertex 0 0 1.0000001\nendloop\nendfacet\n"
+      "endsolid t\n";
+  auto mesh = read_mesh_from_memory(stl, "stl");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  EXPECT_EQ(mesh->vertex_count(), 5);
+  const auto report = validate_balloon_mesh(*mesh);
+  ASSERT_FALSE(report.ok());
+  expect_contains(report.error(), {"open boundary"});
+}
+
+TEST(MeshIo, ReadsAsciiPly) {
+  const TriMesh original = offset_icosphere(1);
+  auto mesh = read_mesh_from_memory(ascii_ply(original), "ply");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  EXPECT_TRUE(same_geometry(original, *mesh, 1e-6));
+}
+
+TEST(MeshIo, ReadsGltfAndGlbApplyingNodeTransforms) {
+  const TriMesh original = make_icosphere(2.0, 1);
+  const std::string moved = R"([{"mesh":0,"translation":[10,20,30]}])";
+  const Eigen::RowVector3d shift(10, 20, 30);
+  TriMesh expected = original;
+  expected.vertices.rowwise() += shift;
+
+  const std::string gltf = gltf_embedded(original, moved, 1);
+  const std::string binary = glb(original, moved, 1);
+  TemporaryDirectory dir;
+  write_file(dir.file("sphere.gltf"), gltf);
+  write_file(dir.file("sphere.GLB"), binary);
+  const Result<TriMesh> reads[] = {read_mesh_from_memory(gltf, "gltf"), read_mesh_from_memory(binary, "glb"),
+                                   read_mesh(dir.file("sphere.gltf")), read_mesh(dir.file("sphere.GLB"))};
+  for (const auto& mesh : reads) {
+    ASSERT_TRUE(mesh.ok()) << mesh.error();
+    EXPECT_TRUE(same_geometry(expected, *mesh, 1e-6));
+    TriMesh copy = *mesh;
+    const auto report = validate_balloon_mesh(copy);
+    ASSERT_TRUE(report.ok()) << report.error();
+    EXPECT_FALSE(report->flipped);
+  }
+}
+
+TEST(MeshIo, GltfWithExternalBufferReadsFromFileOnly) {
+  const TriMesh original = make_icosphere(2.0, 1);
+  const std::string json = gltf_json(original, R"([{"mesh":0}])", 1, "sphere.bin");
+  TemporaryDirectory dir;
+  write_file(dir.file("sphere.gltf"), json);
+  write_file(dir.file("sphere.bin"), gltf_buffer(original));
+  const auto from_file = read_mesh(dir.file("sphere.gltf"));
+  ASSERT_TRUE(from_file.ok()) << from_file.error();
+  EXPECT_TRUE(same_geometry(original, *from_file, 1e-6));
+  // From memory the buffer cannot be found: an error, not a crash.
+  const auto from_memory = read_mesh_from_memory(json, "gltf");
+  ASSERT_FALSE(from_memory.ok());
+  expect_contains(from_memory.error(), {"cannot read gltf mesh data"});
+}
+
+TEST(MeshIo, GltfMirroringNodeKeepsTheMeshOutward) {
+  // glTF: a negative-determinant transform reverses the winding, so the mirrored mesh stays outward.
+  const TriMesh original = make_icosphere(2.0, 1);
+  auto mesh = read_mesh_from_memory(gltf_embedded(original, R"([{"mesh":0,"scale":[-1,1,1]}])", 1), "gltf");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  TriMesh mirrored = original;
+  mirrored.vertices.col(0) *= -1.0;
+  mirrored.faces.col(1).swap(mirrored.faces.col(2));
+  EXPECT_TRUE(same_geometry(mirrored, *mesh, 1e-6));
+  const auto report = validate_balloon_mesh(*mesh);
+  ASSERT_TRUE(report.ok()) << report.error();
+  EXPECT_FALSE(report->flipped);
+}
+
+TEST(MeshIo, GltfInstancesAreMergedIntoOneMesh) {
+  const TriMesh original = make_icosphere(2.0, 1);
+  const std::string nodes =
+      R"([{"mesh":0},{"mesh":0,"translation":[10,0,0]}])";
+  auto mesh = read_mesh_from_memory(gltf_embedded(original, nodes, 2), "gltf");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  EXPECT_EQ(mesh->vertex_count(), 84);
+  EXPECT_EQ(mesh->face_count(), 160);
+  const auto report = validate_balloon_mesh(*mesh);
+  ASSERT_FALSE(report.ok());
+  expect_contains(report.error(), {"several connected components"});
+}
+
+TEST(MeshIo, RejectsNonTriangleFacesNamingTheFace) {
+  const std::string obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nf 1 2 5\nf 1 2 3 4\n";
+  auto from_obj = read_mesh_from_memory(obj, "obj");
+  ASSERT_FALSE(from_obj.ok());
+  expect_contains(from_obj.error(), {"face 1", "4 vertices", "only triangles", "line 7"});
+
+  const std::string off = "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n4 0 1 2 3\n";
+  auto from_off = read_mesh_from_memory(off, "off");
+  ASSERT_FALSE(from_off.ok());
+  expect_contains(from_off.error(), {"face 1", "4 vertices", "only triangles"});
+
+  auto from_ply = read_mesh_from_memory(ascii_ply(make_icosphere(1.0, 0), 6), "ply");
+  ASSERT_FALSE(from_ply.ok());
+  expect_contains(from_ply.error(), {"face 6", "4 vertices", "only triangles"});
+
+  TemporaryDirectory dir;
+  write_file(dir.file("quad.obj"), obj);
+  auto from_file = read_mesh(dir.file("quad.obj"));
+  ASSERT_FALSE(from_file.ok());
+  expect_contains(from_file.error(), {dir.file("quad.obj"), "face 1"});
+}
+
+TEST(MeshIo, RejectsUnreadableFilesAndUnknownFormats) {
+  TemporaryDirectory dir;
+  const std::string missing = dir.file("missing.obj");
+  auto result = read_mesh(missing);
+  ASSERT_FALSE(result.ok());
+  expect_contains(result.error(), {missing, "no such file"});
+
+  write_file(dir.file("mesh.xyz"), "v 0 0 0\n");
+  result = read_mesh(dir.file("mesh.xyz"));
+  ASSERT_FALSE(result.ok());
+  expect_contains(result.error(), {"mesh.xyz", "unsupported format", ".xyz"});
+
+  result = read_mesh(dir.path().string());
+  ASSERT_FALSE(result.ok());
+  expect_contains(result.error(), {"no file extension"});
+
+  std::filesystem::create_directory(dir.file("folder.stl"));
+  result = read_mesh(dir.file("folder.stl"));
+  ASSERT_FALSE(result.ok());
+  expect_contains(result.error(), {"folder.stl", "directory"});
+
+  write_file(dir.file("empty.off"), "");
+  result = read_mesh(dir.file("empty.off"));
+  ASSERT_FALSE(result.ok());
+  expect_contains(result.error(), {"empty.off", "empty"});
+
+  result = read_mesh_from_memory("v 0 0 0\n", "fbx");
+  ASSERT_FALSE(result.ok());
+  expect_contains(result.error(), {"unsupported format", "fbx"});
+  EXPECT_TRUE(is_readable_mesh_format(".GLB"));
+  EXPECT_FALSE(is_readable_mesh_format("fbx"));
+  EXPECT_TRUE(is_writable_mesh_format("PLY"));
+  EXPECT_FALSE(is_writable_mesh_format("off"));
+}
+
+TEST(MeshIo, RejectsParseErrorsAndMeshesWithoutTriangles) {
+  struct Case {
+    const char* bytes;
+    const char* format;
+    std::initializer_list<std::string> fragments;
+  };
+  const Case cases[] = {
+      {"v 0 0 0\nv 1 2\n", "obj", {"line 2", "3 coordinates"}},
+      {"v 0 0 0\nv 1 x 0\nv 0 1 0\nf 1 2 3\n", "obj", {"line 2", "bad vertex coordinate", "'x'"}},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 5\n", "obj", {"face 0", "vertex 5"}},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 0 2\n", "obj", {"bad vertex reference", "face 0"}},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\n", "obj", {"no triangles"}},
+      {"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", "off", {"face 0", "vertex 3", "out of range"}},
+      {"OFF\n3 1 0\n0 0 0\n1 0 0\n", "off", {"file ends", "2 of 3 vertices"}},
+      {"PLY\n3 1 0\n", "off", {"not an OFF file"}},
+      {"4OFF\n3 1 0\n", "off", {"unsupported OFF variant"}},
+      {"OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n", "off", {"no triangles"}},
+      {"this is not an stl file at all, and it is certainly not binary either.......................", "stl",
+       {"cannot read stl mesh data", "parse error", "the data"}},
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+       "end_header\n0 0 0\n",
+       "ply",
+       {"cannot read ply mesh data"}},
+      {"{ not json", "gltf", {"cannot read gltf mesh data", "parse error"}},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.bytes);
+    const auto result = read_mesh_from_memory(c.bytes, c.format);
+    ASSERT_FALSE(result.ok());
+    expect_contains(result.error(), c.fragments);
+    EXPECT_EQ(result.error().find("magic"), std::string::npos) << "assimp's made-up file name leaked";
+  }
+  EXPECT_FALSE(read_mesh_from_memory("", "obj").ok());
+}
+
+TEST(MeshIo, FailedWritesLeaveNoFile) {
+  const TriMesh mesh = make_icosphere(1.0, 1);
+  TemporaryDirectory dir;
+
+  auto written = write_mesh(mesh, dir.file("sphere.off"));
+  ASSERT_FALSE(written.ok());
+  expect_contains(written.error(), {"sphere.off", "unsupported format", "obj, stl, ply"});
+
+  written = write_mesh(mesh, dir.file("no/such/folder/sphere.obj"));
+  ASSERT_FALSE(written.ok());
+  expect_contains(written.error(), {"sphere.obj", "cannot create"});
+
+  // The rename onto an existing folder fails: the temporary file must be gone afterwards.
+  std::filesystem::create_directory(dir.file("taken.ply"));
+  written = write_mesh(mesh, dir.file("taken.ply"));
+  ASSERT_FALSE(written.ok());
+  expect_contains(written.error(), {"taken.ply"});
+  EXPECT_EQ(dir.entry_count(), 1);
+  EXPECT_TRUE(std::filesystem::is_directory(dir.file("taken.ply")));
+
+  TriMesh broken = mesh;
+  broken.faces(0, 0) = 1000;
+  EXPECT_THROW(write_mesh_to_memory(broken, "obj"), std::invalid_argument);
+  EXPECT_THROW(write_mesh_to_memory(mesh, "off"), std::invalid_argument);
+}
+
+TEST(MeshIo, OverwritesAnExistingFile) {
+  TemporaryDirectory dir;
+  const std::string path = dir.file("sphere.obj");
+  write_file(path, "old contents that are longer than nothing\n");
+  const TriMesh mesh = make_icosphere(1.0, 0);
+  ASSERT_TRUE(write_mesh(mesh, path).ok());
+  const auto back = read_mesh(path);
+  ASSERT_TRUE(back.ok()) << back.error();
+  EXPECT_EQ(back->vertex_count(), 12);
+  EXPECT_EQ(dir.entry_count(), 1);
+}
+
+}  // namespace
+}  // namespace balloon

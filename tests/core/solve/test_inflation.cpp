@@ -1,0 +1,176 @@
+// The forward simulator against exact solutions: a thin sphere follows p = h Psi'(l) / (R l^2) for every
+// material, on both sides of a pressure maximum, and stiff or extreme cases end without NaN.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "mesh/icosphere.hpp"
+#include "solve/inflation.hpp"
+
+namespace balloon {
+namespace {
+
+Material make(MaterialModel model, double a, double b = 0, double c = 0) {
+  Material m;
+  m.model = model;
+  m.params = {a, b, c};
+  return m;
+}
+
+/// Closed-form pressure (kPa) of a thin incompressible sphere of rest radius R and thickness h at
+/// equibiaxial stretch l: energy 4 pi R^2 h Psi(l) against p * 4/3 pi R^3 l^3.
+double sphere_pressure_kpa(const Material& material, double h, double R, double l) {
+  const double I1 = 2 * l * l + std::pow(l, -4), I2 = std::pow(l, 4) + 2 * std::pow(l, -2);
+  const double dI1 = 4 * l - 4 * std::pow(l, -5), dI2 = 4 * std::pow(l, 3) - 4 * std::pow(l, -3);
+  const InvariantDerivatives d = strain_energy(material, I1, I2);
+  return 1e3 * h * (d.d1 * dI1 + d.d2 * dI2) / (R * l * l);
+}
+
+double mesh_volume(const TriMesh& m) {
+  double v = 0;
+  for (int f = 0; f < m.face_count(); ++f)
+    v += m.vertices.row(m.faces(f, 0)).dot(m.vertices.row(m.faces(f, 1)).cross(m.vertices.row(m.faces(f, 2)))) / 6;
+  return v;
+}
+
+double mesh_area(const TriMesh& m) {
+  double a = 0;
+  for (int f = 0; f < m.face_count(); ++f) {
+    const Eigen::RowVector3d e1 = m.vertices.row(m.faces(f, 1)) - m.vertices.row(m.faces(f, 0));
+    const Eigen::RowVector3d e2 = m.vertices.row(m.faces(f, 2)) - m.vertices.row(m.faces(f, 0));
+    a += 0.5 * e1.cross(e2).norm();
+  }
+  return a;
+}
+
+struct SphereCase {
+  const char* label;
+  Material material;
+  std::vector<double> stretches;
+};
+
+class SphereLawTest : public ::testing::TestWithParam<SphereCase> {};
+
+TEST_P(SphereLawTest, PressureMatchesClosedFormWithinHalfPercent) {
+  const SphereCase c = GetParam();
+  const TriMesh sphere = make_icosphere(10.0, 4);  // 2562 vertices
+  ASSERT_GE(sphere.vertex_count(), 2500);
+  // The polyhedron's own radius: the sphere with its volume-to-area ratio.
+  const double radius = 3.0 * mesh_volume(sphere) / mesh_area(sphere);
+  const double h = 0.5;
+  Positions previous = sphere.vertices;
+  for (double l : c.stretches) {
+    InflationOptions options;
+    options.material = c.material;
+    options.thickness_mm = h;
+    options.control = InflationControl::VolumeRatio;
+    options.volume_ratio = l * l * l;
+    const InflationResult result = inflate(sphere, options, &previous);
+    ASSERT_TRUE(result.converged) << c.label << " l=" << l << ": " << result.message;
+    previous = result.deformed;
+    const double stretch = std::cbrt(result.volume_ratio);
+    EXPECT_NEAR(stretch, l, 1e-6 * l);
+    const double expected = sphere_pressure_kpa(c.material, h, radius, stretch);
+    EXPECT_NEAR(result.pressure_kpa, expected, 5e-3 * std::abs(expected)) << c.label << " at stretch " << l;
+    // The rigid support carries no load and the shape stays round.
+    const Eigen::VectorXd radii = result.deformed.rowwise().norm();
+    const Eigen::RowVector3d center = result.deformed.colwise().mean();
+    const Eigen::VectorXd centered = (result.deformed.rowwise() - center).rowwise().norm();
+    EXPECT_LT((centered.array() - centered.mean()).abs().maxCoeff(), 1e-2 * centered.mean()) << c.label;
+    EXPECT_LT(result.residual_norm, 1e-6 * result.pressure_kpa * 1e-3 * 4 * M_PI * radius * radius);
+    (void)radii;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    AllMaterials, SphereLawTest,
+    ::testing::Values(
+        // Neo-Hookean peaks at l = 7^(1/6) = 1.383: stretches past it are reached by volume control only.
+        SphereCase{"neo_hookean", make(MaterialModel::NeoHookean, 0.3), {1.1, 1.3, 1.5, 2.0, 2.5, 3.0}},
+        SphereCase{"mooney_rivlin", make(MaterialModel::MooneyRivlin, 0.18, 0.02), {1.1, 1.3, 1.6, 2.0, 2.5, 3.0}},
+        SphereCase{"hart_smith", make(MaterialModel::HartSmith, 0.1, 3e-4, 1.0), {1.1, 1.5, 2.0, 3.0, 4.0, 5.0}}),
+    [](const auto& info) { return std::string(info.param.label); });
+
+TEST(Inflation, PressureControlFindsTheAscendingBranch) {
+  const TriMesh sphere = make_icosphere(10.0, 3);
+  const Material nh = make(MaterialModel::NeoHookean, 0.3);
+  const double radius = 3.0 * mesh_volume(sphere) / mesh_area(sphere);
+  InflationOptions options;
+  options.material = nh;
+  options.control = InflationControl::Pressure;
+  const double peak = sphere_pressure_kpa(nh, 0.5, radius, std::pow(7.0, 1.0 / 6.0));
+  options.pressure_kpa = 0.8 * peak;
+  const InflationResult result = inflate(sphere, options);
+  ASSERT_TRUE(result.converged) << result.message;
+  EXPECT_NEAR(result.pressure_kpa, 0.8 * peak, 1e-9 * peak);
+  const double stretch = std::cbrt(result.volume_ratio);
+  EXPECT_LT(stretch, std::pow(7.0, 1.0 / 6.0));
+  EXPECT_NEAR(sphere_pressure_kpa(nh, 0.5, radius, stretch), 0.8 * peak, 5e-3 * peak);
+}
+
+TEST(Inflation, PressureAboveTheMaximumIsReportedNotCrashed) {
+  const TriMesh sphere = make_icosphere(10.0, 2);
+  InflationOptions options;
+  options.material = make(MaterialModel::NeoHookean, 0.3);
+  options.control = InflationControl::Pressure;
+  options.pressure_kpa = 100.0;  // the peak is about 19 kPa
+  const InflationResult result = inflate(sphere, options);
+  EXPECT_FALSE(result.converged);
+  EXPECT_NE(result.message.find("maximum pressure"), std::string::npos) << result.message;
+  EXPECT_TRUE(result.deformed.allFinite());
+}
+
+TEST(Inflation, BadOptionsAreReportedNotThrown) {
+  const TriMesh sphere = make_icosphere(10.0, 1);
+  InflationOptions options;
+  options.material = make(MaterialModel::NeoHookean, 0.3);
+  options.thickness_mm = -1;
+  options.volume_ratio = 2;
+  InflationResult result = inflate(sphere, options);
+  EXPECT_FALSE(result.converged);
+  EXPECT_NE(result.message.find("thickness"), std::string::npos);
+  options.thickness_mm = 0.5;
+  options.volume_ratio = std::nan("");
+  result = inflate(sphere, options);
+  EXPECT_FALSE(result.converged);
+  EXPECT_NE(result.message.find("volume ratio"), std::string::npos);
+}
+
+struct ExtremeCase {
+  const char* label;
+  Material material;
+  double thickness;
+  double volume_ratio;
+  int subdivisions;
+};
+
+class ExtremeInflationTest : public ::testing::TestWithParam<ExtremeCase> {};
+
+TEST_P(ExtremeInflationTest, EndsWithoutNaNAndConvergesOrSaysWhy) {
+  const ExtremeCase c = GetParam();
+  const TriMesh sphere = make_icosphere(10.0, c.subdivisions);
+  InflationOptions options;
+  options.material = c.material;
+  options.thickness_mm = c.thickness;
+  options.volume_ratio = c.volume_ratio;
+  const InflationResult result = inflate(sphere, options);
+  EXPECT_TRUE(result.deformed.allFinite()) << c.label;
+  EXPECT_TRUE(std::isfinite(result.pressure_kpa)) << c.label;
+  if (!result.converged) {
+    EXPECT_FALSE(result.message.empty()) << c.label;
+  }
+  // These cases are all solvable: a sphere has an equilibrium at every volume.
+  EXPECT_TRUE(result.converged) << c.label << ": " << result.message;
+  EXPECT_NEAR(result.volume_ratio, c.volume_ratio, 1e-6 * c.volume_ratio) << c.label;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Stiff, ExtremeInflationTest,
+    ::testing::Values(ExtremeCase{"hart_smith_k1_1e_2", make(MaterialModel::HartSmith, 0.1, 1e-2, 1.0), 0.5, 64.0, 3},
+                      ExtremeCase{"latex_volume_ratio_125", make(MaterialModel::HartSmith, 0.17, 3e-3, 0.5), 0.5, 125.0, 3},
+                      ExtremeCase{"thin_0_05_mm", make(MaterialModel::NeoHookean, 0.3), 0.05, 8.0, 3},
+                      ExtremeCase{"coarse_12_vertices", make(MaterialModel::MooneyRivlin, 0.18, 0.02), 0.5, 8.0, 0}),
+    [](const auto& info) { return std::string(info.param.label); });
+
+}  // namespace
+}  // namespace balloon
