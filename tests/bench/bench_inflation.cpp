@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "design/target_preparation.hpp"
 #include "mesh/icosphere.hpp"
 #include "mesh/mesh_checks.hpp"
 #include "mesh/mesh_geometry.hpp"
@@ -62,6 +63,14 @@ int main(int argc, char** argv) {
   const int largest = quick ? 4 : 6;
   for (int k = 3; k <= largest; ++k)
     spheres.push_back(run("icosphere r=50mm sub " + std::to_string(k), balloon::make_icosphere(50.0, k), *material));
+  {
+    // The 5k-vertex target size: an icosphere remeshed isotropically to about 5,000 vertices.
+    balloon::TargetPreparationOptions prep;
+    prep.resolution = 5000;
+    prep.keep_vertex_tolerance = 0.0;
+    auto sphere5k = balloon::prepare_target(balloon::make_icosphere(50.0, 5), prep);
+    if (sphere5k) run("remeshed sphere r=50mm", sphere5k->mesh, *material);
+  }
   if (spheres.size() >= 2) {
     const auto& a = spheres.front();
     const auto& b = spheres.back();

@@ -5,6 +5,9 @@
 #include <cmath>
 
 #include "mesh/icosphere.hpp"
+#include "mesh/mesh_checks.hpp"
+#include "mesh/mesh_geometry.hpp"
+#include "mesh/mesh_io.hpp"
 #include "solve/inflation.hpp"
 
 namespace balloon {
@@ -171,6 +174,41 @@ INSTANTIATE_TEST_SUITE_P(
                       ExtremeCase{"thin_0_05_mm", make(MaterialModel::NeoHookean, 0.3), 0.05, 8.0, 3},
                       ExtremeCase{"coarse_12_vertices", make(MaterialModel::MooneyRivlin, 0.18, 0.02), 0.5, 8.0, 0}),
     [](const auto& info) { return std::string(info.param.label); });
+
+}  // namespace
+}  // namespace balloon
+
+namespace balloon {
+namespace {
+
+// Real meshes with slivers (hand, min angle 0.7 deg), flat faces and sharp edges (cube) and a bumpy
+// surface: load, validate, and inflate to equilibrium at 100 mm size.
+class SampleMeshInflationTest : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(SampleMeshInflationTest, InflatesToVolumeRatioEight) {
+  auto mesh = read_mesh(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/" + GetParam());
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  ASSERT_TRUE(validate_balloon_mesh(*mesh).ok());
+  mesh->vertices *= 100.0 / bounding_box_diagonal(mesh->vertices);
+  InflationOptions options;
+  options.material = *parse_material_spec("silicone");
+  options.volume_ratio = 8.0;
+  const InflationResult result = inflate(*mesh, options);
+  ASSERT_TRUE(result.converged) << GetParam() << ": " << result.message;
+  EXPECT_NEAR(result.volume_ratio, 8.0, 1e-6);
+  EXPECT_GT(result.pressure_kpa, 0.0);
+  EXPECT_TRUE(result.deformed.allFinite());
+  EXPECT_GT(result.max_stretch, result.mean_stretch);
+}
+
+INSTANTIATE_TEST_SUITE_P(Samples, SampleMeshInflationTest,
+                         ::testing::Values("hand_fist.off", "cube_866.off", "stanford_bunny_1839.obj"),
+                         [](const auto& info) {
+                           std::string name = info.param;
+                           for (char& ch : name)
+                             if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+                           return name;
+                         });
 
 }  // namespace
 }  // namespace balloon
