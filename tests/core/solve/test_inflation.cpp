@@ -29,22 +29,8 @@ double sphere_pressure_kpa(const Material& material, double h, double R, double 
   return 1e3 * h * (d.d1 * dI1 + d.d2 * dI2) / (R * l * l);
 }
 
-double mesh_volume(const TriMesh& m) {
-  double v = 0;
-  for (int f = 0; f < m.face_count(); ++f)
-    v += m.vertices.row(m.faces(f, 0)).dot(m.vertices.row(m.faces(f, 1)).cross(m.vertices.row(m.faces(f, 2)))) / 6;
-  return v;
-}
-
-double mesh_area(const TriMesh& m) {
-  double a = 0;
-  for (int f = 0; f < m.face_count(); ++f) {
-    const Eigen::RowVector3d e1 = m.vertices.row(m.faces(f, 1)) - m.vertices.row(m.faces(f, 0));
-    const Eigen::RowVector3d e2 = m.vertices.row(m.faces(f, 2)) - m.vertices.row(m.faces(f, 0));
-    a += 0.5 * e1.cross(e2).norm();
-  }
-  return a;
-}
+double mesh_volume(const TriMesh& m) { return enclosed_volume(m.vertices, m.faces); }
+double mesh_area(const TriMesh& m) { return surface_area(m.vertices, m.faces); }
 
 struct SphereCase {
   const char* label;
