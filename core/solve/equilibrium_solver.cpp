@@ -51,34 +51,10 @@ double EquilibriumSolver::force_scale(const Eigen::VectorXd& x, double pressure_
   return std::abs(pressure_mpa) * v.norm() + floor;
 }
 
-bool EquilibriumSolver::factorize_stiffness(const Eigen::VectorXd& x, double pressure_mpa, bool allow_one_negative,
-                                            const Eigen::VectorXd* constraint_gradient, bool& exact) {
+bool EquilibriumSolver::factorize_stiffness(const Eigen::VectorXd& x, double pressure_mpa) {
   m_model.assemble_hessian(x, pressure_mpa, m_assembly, false);
-  exact = true;
-  if (!m_prefer_ldlt || !allow_one_negative) {
-    if (m_solver.factorize_llt(m_assembly.values()) == SparseSolver::Status::Ok) {
-      m_prefer_ldlt = false;
-      return true;
-    }
-  }
-  if (allow_one_negative && constraint_gradient) {
-    // Past a pressure maximum K has one negative eigenvalue along the inflation mode; the volume
-    // constraint removes it when v^T K^-1 v < 0 (the bordered KKT matrix then has the right inertia).
-    if (m_solver.factorize_ldlt(m_assembly.values()) == SparseSolver::Status::Ok) {
-      const int negative = m_solver.negative_pivots();
-      if (negative == 0) return true;
-      if (negative == 1) {
-        const Eigen::VectorXd b = m_solver.solve(*constraint_gradient);
-        if (constraint_gradient->dot(b) < 0.0) {
-          m_prefer_ldlt = true;
-          return true;
-        }
-      }
-    }
-    m_prefer_ldlt = false;
-  }
+  if (m_solver.factorize_llt(m_assembly.values()) == SparseSolver::Status::Ok) return true;
   // Not a stable configuration: shift until positive definite (a damped, inexact Newton step).
-  exact = false;
   const double base = std::max(1e-30, m_assembly.mean_abs_diagonal());
   for (double shift = 1e-6 * base; shift < 1e6 * base; shift *= 10.0) {
     if (m_solver.factorize_llt(m_assembly.values(), shift) == SparseSolver::Status::Ok) return true;
@@ -116,8 +92,7 @@ NewtonReport EquilibriumSolver::solve_pressure(Eigen::VectorXd& x, double pressu
       return report;
     }
     if (should_stop(settings, report)) return report;
-    bool exact = true;
-    if (!factorize_stiffness(x, pressure_mpa, false, nullptr, exact)) {
+    if (!factorize_stiffness(x, pressure_mpa)) {
       report.message = "stiffness matrix could not be factorized";
       return report;
     }

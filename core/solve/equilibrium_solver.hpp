@@ -58,9 +58,8 @@ class EquilibriumSolver {
   int factorizations() const { return m_solver.factorizations(); }
 
  private:
-  /// Factorizes K + shift I, escalating the shift until acceptable. Returns false if impossible.
-  bool factorize_stiffness(const Eigen::VectorXd& x, double pressure_mpa, bool allow_one_negative,
-                           const Eigen::VectorXd* constraint_gradient, bool& exact);
+  /// Factorizes K, or K + shift I with the smallest shift found that makes it positive definite.
+  bool factorize_stiffness(const Eigen::VectorXd& x, double pressure_mpa);
 
   /// Exact stiffness for the volume-controlled KKT step, accepted when its inertia is right.
   bool factorize_exact_for_volume(const Eigen::VectorXd& x, double pressure_mpa, const Eigen::VectorXd& v);
@@ -71,7 +70,6 @@ class EquilibriumSolver {
   fem::BalloonModel& m_model;
   fem::TriangleAssembly m_assembly;
   SparseSolver m_solver;
-  bool m_prefer_ldlt = false;
   int m_skip_ldlt = 0;
   int m_exact_fails_left = 0;
   int m_last_unstable_modes = 0;
