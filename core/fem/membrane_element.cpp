@@ -93,11 +93,14 @@ double membrane_energy(const Material& material, double thickness, const RestTri
 }
 
 Vector9d membrane_gradient(const Material& material, double thickness, const RestTriangle& rest, const Vector9d& x) {
-  double energy;
-  Vector9d gradient;
-  Matrix9d hessian;
-  membrane_energy_gradient_hessian(material, thickness, rest, x, energy, gradient, hessian);
-  return gradient;
+  // Residuals and line searches call this often: only the 3-variable jet, no 9x9 products.
+  const EdgeGram g = edge_gram(x);
+  if (collapsed(g)) return Vector9d::Zero();
+  using J3 = Jet<3>;
+  const J3 w = gram_energy<3>(material, thickness, J3::variable(g.s11, 0), J3::variable(g.s12, 1),
+                              J3::variable(g.s22, 2), J3::constant(rest.m11), J3::constant(rest.m12),
+                              J3::constant(rest.m22));
+  return gram_jacobian(g).transpose() * w.g;
 }
 
 void membrane_energy_gradient_hessian(const Material& material, double thickness, const RestTriangle& rest,

@@ -30,6 +30,11 @@ bool should_stop(const NewtonSettings& settings, NewtonReport& report) {
 EquilibriumSolver::EquilibriumSolver(fem::BalloonModel& model, const std::vector<bool>& fixed_coordinate)
     : m_model(model), m_assembly(model.faces(), model.vertex_count(), fixed_coordinate) {
   m_solver.set_pattern(m_assembly.free_count(), m_assembly.column_starts(), m_assembly.row_indices());
+  double mean_thickness = 0.0;
+  for (int f = 0; f < m_model.faces().rows(); ++f) mean_thickness += m_model.thickness(f);
+  mean_thickness /= static_cast<double>(std::max<Eigen::Index>(1, m_model.faces().rows()));
+  // A thousandth of the membrane force a unit strain would cause over the surface.
+  m_force_floor = 1e-3 * m_model.material().shear_modulus() * mean_thickness * std::sqrt(m_model.rest_area());
 }
 
 Eigen::VectorXd EquilibriumSolver::residual(const Eigen::VectorXd& x, double pressure_mpa) const {
@@ -43,12 +48,7 @@ double EquilibriumSolver::force_scale(const Eigen::VectorXd& x, double pressure_
   Eigen::VectorXd v = m_model.volume_gradient(x);
   for (int c = 0; c < v.size(); ++c)
     if (m_assembly.free_index(c) < 0) v[c] = 0.0;
-  double mean_thickness = 0.0;
-  for (int f = 0; f < m_model.faces().rows(); ++f) mean_thickness += m_model.thickness(f);
-  mean_thickness /= std::max<Eigen::Index>(1, m_model.faces().rows());
-  // Floor: a thousandth of the membrane force a unit strain would cause over the surface.
-  const double floor = 1e-3 * m_model.material().shear_modulus() * mean_thickness * std::sqrt(m_model.rest_area());
-  return std::abs(pressure_mpa) * v.norm() + floor;
+  return std::abs(pressure_mpa) * v.norm() + m_force_floor;
 }
 
 bool EquilibriumSolver::factorize_stiffness(const Eigen::VectorXd& x, double pressure_mpa) {
@@ -146,6 +146,7 @@ NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressur
       return report;
     }
     if (report.residual_norm <= force_tolerance && std::abs(c) <= volume_tolerance) {
+      report.unstable_modes = m_last_unstable_modes;
       report.converged = true;
       report.message = "converged";
       return report;
@@ -172,7 +173,7 @@ NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressur
       if (std::abs(vb) > 0.0) {
         const double dp = (-c - v.dot(a)) / vb;
         const Eigen::VectorXd step = m_assembly.extend(a + dp * b);
-        const double merit0 = merit(x, pressure_mpa, force_tolerance);
+        const double merit0 = std::pow(report.residual_norm / force_tolerance, 2) + std::pow(c / volume_tolerance, 2);
         double t = 1.0;
         for (int k = 0; k < 8 && !exact; ++k, t *= 0.5) {
           const Eigen::VectorXd trial = x + t * step;

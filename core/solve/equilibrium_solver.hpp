@@ -22,6 +22,9 @@ struct NewtonReport {
   int iterations = 0;
   double residual_norm = 0.0;  ///< |grad W - p grad V| over the free coordinates (N)
   double volume_error = 0.0;   ///< V - V_target (mm^3), volume control only
+  /// Volume control: directions along which the converged state is unstable (0 = a stable
+  /// equilibrium, more = a saddle such as a symmetry-breaking mode), from the last exact factorization.
+  int unstable_modes = 0;
 };
 
 struct NewtonSettings {
@@ -73,6 +76,7 @@ class EquilibriumSolver {
   int m_skip_ldlt = 0;
   int m_exact_fails_left = 0;
   int m_last_unstable_modes = 0;
+  double m_force_floor = 0.0;  ///< N, see force_scale()
 };
 
 }  // namespace balloon

@@ -150,8 +150,8 @@ class InflationRun {
     m_newton_iterations += report.iterations;
     if (!report.converged) return false;
     state = {x, pressure, target_volume};
+    m_unstable_modes = report.unstable_modes;
     ++m_load_steps;
-    m_residual = report.residual_norm;
     report_progress(state, report.residual_norm, true);
     return true;
   }
@@ -166,7 +166,9 @@ class InflationRun {
     NewtonReport report;
     if (std::abs(step) <= 1e-14 * target_volume) {
       // Already there in volume; still solve for equilibrium.
-      return volume_step(state, target_volume, report) || (message = "no equilibrium found: " + report.message, false);
+      if (volume_step(state, target_volume, report)) return true;
+      message = "no equilibrium found: " + report.message;
+      return false;
     }
     while (std::abs(target_volume - state.volume) > 1e-14 * target_volume) {
       const double next = std::abs(step) >= std::abs(target_volume - state.volume) ? target_volume : state.volume + step;
@@ -242,8 +244,7 @@ class InflationRun {
           return false;
         }
         state = {x, target_pressure, m_model.volume(x)};
-        m_residual = report.residual_norm;
-        return true;
+            return true;
       }
       if (report.iterations <= 6) step *= 2.0;
     }
@@ -261,6 +262,7 @@ class InflationRun {
     Eigen::VectorXd r = m_model.elastic_gradient(state.x) - state.pressure * m_model.volume_gradient(state.x);
     for (int v : m_options.fixed_vertices) r.segment<3>(3 * v).setZero();
     result.residual_norm = r.norm();
+    result.unstable_modes = m_unstable_modes;
     result.newton_iterations = m_newton_iterations;
     result.factorizations = m_solver.factorizations();
     result.load_steps = m_load_steps;
@@ -276,7 +278,7 @@ class InflationRun {
   double m_start;
   int m_newton_iterations = 0;
   int m_load_steps = 0;
-  double m_residual = 0.0;
+  int m_unstable_modes = 0;
 };
 
 std::string options_problem(const TriMesh& rest, const InflationOptions& options) {

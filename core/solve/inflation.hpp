@@ -39,6 +39,7 @@ struct InflationResult {
   double mean_stretch = 0.0;      ///< sqrt(A / A_rest), area-mean extension ratio
   double max_stretch = 0.0;       ///< largest principal stretch over all triangles
   double residual_norm = 0.0;     ///< |f_mem + f_p| over all free coordinates (N)
+  int unstable_modes = 0;         ///< volume control: unstable directions of the equilibrium (0 = stable)
   int newton_iterations = 0;
   int factorizations = 0;
   int load_steps = 0;

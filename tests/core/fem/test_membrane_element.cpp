@@ -149,8 +149,8 @@ TEST_P(MembraneElementTest, ProjectedHessianIsPositiveSemiDefinite) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllMaterials, MembraneElementTest, ::testing::ValuesIn(cases()),
-                         [](const auto& info) {
-                           std::string name = info.param.label;
+                         [](const auto& test_info) {
+                           std::string name = test_info.param.label;
                            for (char& ch : name)
                              if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
                            return name;

@@ -62,12 +62,10 @@ TEST_P(SphereLawTest, PressureMatchesClosedFormWithinHalfPercent) {
     const double expected = sphere_pressure_kpa(c.material, h, radius, stretch);
     EXPECT_NEAR(result.pressure_kpa, expected, 5e-3 * std::abs(expected)) << c.label << " at stretch " << l;
     // The rigid support carries no load and the shape stays round.
-    const Eigen::VectorXd radii = result.deformed.rowwise().norm();
     const Eigen::RowVector3d center = result.deformed.colwise().mean();
     const Eigen::VectorXd centered = (result.deformed.rowwise() - center).rowwise().norm();
     EXPECT_LT((centered.array() - centered.mean()).abs().maxCoeff(), 1e-2 * centered.mean()) << c.label;
     EXPECT_LT(result.residual_norm, 1e-6 * result.pressure_kpa * 1e-3 * 4 * M_PI * radius * radius);
-    (void)radii;
   }
 }
 
@@ -78,7 +76,7 @@ INSTANTIATE_TEST_SUITE_P(
         SphereCase{"neo_hookean", make(MaterialModel::NeoHookean, 0.3), {1.1, 1.3, 1.5, 2.0, 2.5, 3.0}},
         SphereCase{"mooney_rivlin", make(MaterialModel::MooneyRivlin, 0.18, 0.02), {1.1, 1.3, 1.6, 2.0, 2.5, 3.0}},
         SphereCase{"hart_smith", make(MaterialModel::HartSmith, 0.1, 3e-4, 1.0), {1.1, 1.5, 2.0, 3.0, 4.0, 5.0}}),
-    [](const auto& info) { return std::string(info.param.label); });
+    [](const auto& test_info) { return std::string(test_info.param.label); });
 
 TEST(Inflation, PressureControlFindsTheAscendingBranch) {
   const TriMesh sphere = make_icosphere(10.0, 3);
@@ -159,7 +157,7 @@ INSTANTIATE_TEST_SUITE_P(
                       ExtremeCase{"latex_volume_ratio_125", make(MaterialModel::HartSmith, 0.17, 3e-3, 0.5), 0.5, 125.0, 3},
                       ExtremeCase{"thin_0_05_mm", make(MaterialModel::NeoHookean, 0.3), 0.05, 8.0, 3},
                       ExtremeCase{"coarse_12_vertices", make(MaterialModel::MooneyRivlin, 0.18, 0.02), 0.5, 8.0, 0}),
-    [](const auto& info) { return std::string(info.param.label); });
+    [](const auto& test_info) { return std::string(test_info.param.label); });
 
 }  // namespace
 }  // namespace balloon
@@ -189,8 +187,8 @@ TEST_P(SampleMeshInflationTest, InflatesToVolumeRatioEight) {
 
 INSTANTIATE_TEST_SUITE_P(Samples, SampleMeshInflationTest,
                          ::testing::Values("hand_fist.off", "cube_866.off", "stanford_bunny_1839.obj"),
-                         [](const auto& info) {
-                           std::string name = info.param;
+                         [](const auto& test_info) {
+                           std::string name = test_info.param;
                            for (char& ch : name)
                              if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
                            return name;
