@@ -67,6 +67,12 @@ bool EquilibriumSolver::factorize_at(const Eigen::VectorXd& x, double pressure_m
   return m_solver.factorize_llt(m_assembly.values()) == SparseSolver::Status::Ok;
 }
 
+bool EquilibriumSolver::factorize_exact(const Eigen::VectorXd& x, double pressure_mpa) {
+  m_model.assemble_hessian(x, pressure_mpa, m_assembly, false);
+  if (m_solver.factorize_llt(m_assembly.values()) == SparseSolver::Status::Ok) return true;
+  return m_solver.factorize_ldlt(m_assembly.values()) == SparseSolver::Status::Ok;
+}
+
 Eigen::VectorXd EquilibriumSolver::solve_with_factorization(const Eigen::VectorXd& b) const {
   return m_assembly.extend(m_solver.solve(m_assembly.restrict(b)));
 }

@@ -55,6 +55,8 @@ class EquilibriumSolver {
 
   /// Factorizes the exact Hessian of W - p V at x (free coordinates). True if it is positive definite.
   bool factorize_at(const Eigen::VectorXd& x, double pressure_mpa);
+  /// Factorizes the exact Hessian at x, indefinite allowed (LL^T, else LDL^T). False if singular.
+  bool factorize_exact(const Eigen::VectorXd& x, double pressure_mpa);
   /// Solves K y = b with the last factorization; b and y are full 3#V vectors (fixed entries ignored / zero).
   Eigen::VectorXd solve_with_factorization(const Eigen::VectorXd& b) const;
 

@@ -1,0 +1,434 @@
+#include "design/balloon_design.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <memory>
+#include <optional>
+
+#include "design/distance_energy.hpp"
+#include "design/self_collision.hpp"
+#include "design/surface_distance.hpp"
+#include "fem/balloon_model.hpp"
+#include "mesh/mesh_geometry.hpp"
+#include "solve/equilibrium_solver.hpp"
+#include "solve/rigid_modes.hpp"
+
+namespace balloon {
+
+std::string design_method_name(DesignMethod method) {
+  return method == DesignMethod::Adjoint ? "adjoint" : "alm";
+}
+
+Result<DesignMethod> parse_design_method(const std::string& name) {
+  if (name == "adjoint") return DesignMethod::Adjoint;
+  if (name == "alm") return fail("design method 'alm' is not available yet (use 'adjoint')");
+  return fail("unknown design method '" + name + "' (known: adjoint, alm)");
+}
+
+namespace {
+
+constexpr double MPA_PER_KPA = 1e-3;
+
+double now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+Positions scaled_about_centroid(const Positions& points, double scale) {
+  const Eigen::RowVector3d center = points.colwise().mean();
+  Positions scaled = (points.rowwise() - center) * scale;
+  scaled.rowwise() += center;
+  return scaled;
+}
+
+/// Reduced-space design: the inflated shape x is the volume-controlled equilibrium of the rest shape,
+/// warm-started from the previous one; the gradient of E_dist(x(rest)) comes from one adjoint solve of
+/// the bordered equilibrium system with the Hessian factorized at the equilibrium; L-BFGS outside.
+class AdjointDesign {
+ public:
+  AdjointDesign(const TriMesh& target, const DesignOptions& options)
+      : m_target(target),
+        m_options(options),
+        m_start(now_s()),
+        m_rest_mesh(start_shape(target, options)),
+        m_model(m_rest_mesh, options.material,
+                std::vector<double>(static_cast<size_t>(target.face_count()), options.thickness_mm)),
+        m_solver(m_model, rigid_support(m_rest_mesh)),
+        m_distance(target.vertices, target.faces, options.k_length, options.k_bending),
+        m_surface(target),
+        m_target_volume(enclosed_volume(target.vertices, target.faces)) {
+    m_settings.relative_tolerance = 1e-9;
+    m_settings.max_iterations = 60;
+    m_settings.cancel = options.cancel;
+    m_settings.deadline_s = options.max_time_s > 0 ? m_start + options.max_time_s : 0.0;
+    m_rest_free.assign(static_cast<size_t>(3 * target.vertex_count()), true);
+    for (int v : options.nozzle_vertices)
+      for (int a = 0; a < 3; ++a) m_rest_free[static_cast<size_t>(3 * v + a)] = false;
+    // Rest-shape collisions: vertices closer than half a mean edge (eq. 24), costing one kd-tree pass
+    // per accepted iteration and nothing else while no pair is near.
+    SelfCollisionOptions collision;
+    collision.stiffness = 10.0 / std::pow(mean_edge_length(m_rest_mesh), 2);
+    collision.contact_distance_mm = 0.5 * mean_edge_length(m_rest_mesh);
+    m_collision = std::make_unique<SelfCollision>(m_rest_mesh, collision);
+  }
+
+  DesignResult run() {
+    DesignResult result;
+    result.method = DesignMethod::Adjoint;
+    result.bbox_diag_mm = m_surface.bbox_diagonal_mm();
+    result.active_terms.push_back("distance");
+    if (!m_options.nozzle_vertices.empty()) result.active_terms.push_back("nozzle");
+
+    // Start: inflate the downscaled target to the target's volume; that fixes the inflation.
+    Eigen::VectorXd rest = flat(m_rest_mesh.vertices);
+    m_x = flat(scaled_about_centroid(m_rest_mesh.vertices, std::cbrt(m_target_volume / rest_volume(rest))));
+    m_pressure = 0.0;
+    if (!initial_inflation(rest, result)) return finish(result, rest);
+    const SurfaceDistanceStats baseline = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
+    result.baseline_avg_error_mm = baseline.avg_mm;
+    result.baseline_max_error_mm = baseline.max_mm;
+    record(result, 0, baseline);
+
+    Eigen::VectorXd gradient;
+    double objective = objective_value(rest, m_x);
+    if (!objective_gradient(rest, gradient)) {
+      result.message = "the adjoint system could not be factorized at the start";
+      return finish(result, rest);
+    }
+    const double initial_objective = objective;
+    std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> memory;  // (s, y) pairs for L-BFGS
+    int small_decreases = 0;
+    result.message = "iteration limit reached";
+    for (int iteration = 1; iteration <= m_options.max_iterations; ++iteration) {
+      if (m_options.cancel && m_options.cancel->cancelled()) {
+        result.message = "cancelled";
+        break;
+      }
+      if (m_settings.deadline_s > 0 && now_s() > m_settings.deadline_s) {
+        result.message = "time limit reached";
+        break;
+      }
+      Eigen::VectorXd direction = -lbfgs_apply(memory, gradient);
+      if (!(direction.dot(gradient) < 0.0)) {
+        memory.clear();
+        direction = -gradient;
+      }
+      // Trust region on the rest shape: no vertex moves more than 2% of the target's size per step.
+      const double largest = unflatten(direction).rowwise().norm().maxCoeff();
+      const double limit = 0.02 * result.bbox_diag_mm;
+      double t = largest > limit ? limit / largest : 1.0;
+      if (memory.empty()) t = std::min(t, 0.002 * result.bbox_diag_mm / std::max(largest, 1e-300));
+      const double slope = direction.dot(gradient);
+      bool accepted = false;
+      Eigen::VectorXd trial_rest, trial_x;
+      double trial_pressure = 0.0, trial_objective = 0.0;
+      for (int k = 0; k < 12; ++k, t *= 0.5) {
+        trial_rest = keep_rest_volume(rest + t * direction, rest_volume(rest));
+        trial_x = m_x;
+        trial_pressure = m_pressure;
+        if (!equilibrium(trial_rest, trial_x, trial_pressure)) {
+          if (stopped()) break;
+          continue;
+        }
+        trial_objective = objective_value(trial_rest, trial_x);
+        if (trial_objective <= objective + 1e-4 * t * slope) {
+          accepted = true;
+          break;
+        }
+      }
+      if (!accepted) {
+        if (stopped()) {
+          result.message = m_last_report.message;
+          break;
+        }
+        if (!memory.empty()) {  // a stale curvature model: restart from steepest descent
+          memory.clear();
+          continue;
+        }
+        result.converged = true;
+        result.message = "converged: no further decrease along the steepest descent";
+        break;
+      }
+      const Eigen::VectorXd step = trial_rest - rest;
+      rest = trial_rest;
+      m_x = trial_x;
+      m_pressure = trial_pressure;
+      if (m_collision->update(rest) > 0 && !m_collision_seen) {
+        m_collision_seen = true;
+        result.active_terms.push_back("collision");
+      }
+      Eigen::VectorXd new_gradient;
+      objective = objective_value(rest, m_x);
+      if (!objective_gradient(rest, new_gradient)) {
+        result.message = "the adjoint system could not be factorized";
+        break;
+      }
+      const Eigen::VectorXd change = new_gradient - gradient;
+      if (step.dot(change) > 1e-12 * step.norm() * change.norm()) {
+        memory.emplace_back(step, change);
+        if (memory.size() > 10) memory.pop_front();
+      }
+      gradient = new_gradient;
+      const SurfaceDistanceStats stats = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
+      record(result, iteration, stats);
+      result.iterations = iteration;
+      const double relative_decrease = -t * slope / std::max(initial_objective, 1e-300);
+      small_decreases = relative_decrease < 1e-7 ? small_decreases + 1 : 0;
+      if (small_decreases >= 3 || objective <= 1e-14 * initial_objective) {
+        result.converged = true;
+        result.message = "converged";
+        break;
+      }
+    }
+    return finish(result, rest);
+  }
+
+ private:
+  static TriMesh start_shape(const TriMesh& target, const DesignOptions& options) {
+    TriMesh start = target;
+    const double scale = options.scale > 0 ? options.scale : std::cbrt(1.0 / options.volume_ratio);
+    start.vertices = scaled_about_centroid(target.vertices, scale);
+    return start;
+  }
+
+  static std::vector<bool> rigid_support(const TriMesh& mesh) {
+    std::vector<bool> fixed(static_cast<size_t>(3 * mesh.vertex_count()), false);
+    for (int c : rigid_support_coordinates(mesh.vertices)) fixed[static_cast<size_t>(c)] = true;
+    return fixed;
+  }
+
+  static double mean_edge_length(const TriMesh& mesh) {
+    double total = 0.0;
+    for (int f = 0; f < mesh.face_count(); ++f)
+      for (int k = 0; k < 3; ++k)
+        total += (mesh.vertices.row(mesh.faces(f, k)) - mesh.vertices.row(mesh.faces(f, (k + 1) % 3))).norm();
+    return total / (3.0 * std::max(1, mesh.face_count()));
+  }
+
+  /// Restores the rest volume after a step, moving only free vertices along the volume gradient.
+  Eigen::VectorXd keep_rest_volume(Eigen::VectorXd rest, double volume) const {
+    for (int pass = 0; pass < 2; ++pass) {
+      Eigen::VectorXd w = m_model.volume_gradient(rest);
+      for (int c = 0; c < w.size(); ++c)
+        if (!m_rest_free[static_cast<size_t>(c)]) w[c] = 0.0;
+      rest += ((volume - rest_volume(rest)) / w.squaredNorm()) * w;
+    }
+    return rest;
+  }
+
+  double rest_volume(const Eigen::VectorXd& rest) const {
+    return enclosed_volume(unflatten(rest), m_target.faces);
+  }
+
+  bool stopped() const {
+    return m_last_report.message == "cancelled" || m_last_report.message == "time limit reached";
+  }
+
+  /// Volume-controlled equilibrium of `rest` from (x, p); false when it does not converge.
+  bool equilibrium(const Eigen::VectorXd& rest, Eigen::VectorXd& x, double& pressure) {
+    m_model.set_rest_positions(unflatten(rest));
+    m_last_report = m_solver.solve_volume(x, pressure, m_target_volume, m_settings);
+    return m_last_report.converged;
+  }
+
+  /// The start's inflation, by volume steps when one step is too far.
+  bool initial_inflation(const Eigen::VectorXd& rest, DesignResult& result) {
+    m_model.set_rest_positions(unflatten(rest));
+    const double start_volume = rest_volume(rest);
+    const Positions rest_positions = unflatten(rest);
+    double reached = start_volume;
+    Eigen::VectorXd x = rest;
+    double pressure = 0.0;
+    double step = m_target_volume - start_volume;
+    while (reached < m_target_volume) {
+      const double next = std::min(m_target_volume, reached + step);
+      Eigen::VectorXd trial = flat(scaled_about_centroid(unflatten(x), std::cbrt(next / enclosed_volume(unflatten(x), m_target.faces))));
+      double trial_pressure = pressure;
+      if (trial_pressure == 0.0) {
+        const Eigen::VectorXd g = m_solver.residual(trial, 0.0);
+        Eigen::VectorXd v = m_model.volume_gradient(trial);
+        trial_pressure = g.dot(v) / v.squaredNorm();
+      }
+      m_last_report = m_solver.solve_volume(trial, trial_pressure, next, m_settings);
+      if (m_last_report.converged) {
+        x = trial;
+        pressure = trial_pressure;
+        reached = next;
+        continue;
+      }
+      if (stopped() || step < 1e-3 * (m_target_volume - start_volume)) {
+        result.message = "the start shape could not be inflated to the target volume (" + m_last_report.message + ")";
+        return false;
+      }
+      step *= 0.5;
+    }
+    m_x = x;
+    m_pressure = pressure;
+    return true;
+  }
+
+  double objective_value(const Eigen::VectorXd& rest, const Eigen::VectorXd& x) const {
+    double value = m_distance.value(x);
+    if (m_collision->any_active()) value += m_collision->value(rest);
+    return value;
+  }
+
+  /// d objective / d rest through the adjoint of the bordered equilibrium system at (m_x, m_pressure):
+  /// [K -v; -v^T 0] [lambda; mu] = [dE/dx; 0], gradient = -(d grad_x W / d rest)^T lambda.
+  bool objective_gradient(const Eigen::VectorXd& rest, Eigen::VectorXd& gradient) {
+    m_model.set_rest_positions(unflatten(rest));
+    if (!m_solver.factorize_exact(m_x, m_pressure)) return false;
+    Eigen::VectorXd distance_gradient;
+    m_distance.gradient(m_x, distance_gradient);
+    const Eigen::VectorXd v = m_model.volume_gradient(m_x);
+    const Eigen::VectorXd a = m_solver.solve_with_factorization(distance_gradient);
+    const Eigen::VectorXd b = m_solver.solve_with_factorization(v);
+    const double vb = v.dot(b);
+    if (!(std::abs(vb) > 0.0)) return false;
+    const Eigen::VectorXd lambda = a - (v.dot(a) / vb) * b;
+    gradient = Eigen::VectorXd::Zero(rest.size());
+    const Faces& faces = m_target.faces;
+    for (int f = 0; f < faces.rows(); ++f) {
+      fem::Vector9d rest_corners, x_corners, lambda_corners;
+      for (int k = 0; k < 3; ++k) {
+        rest_corners.segment<3>(3 * k) = rest.segment<3>(3 * faces(f, k));
+        x_corners.segment<3>(3 * k) = m_x.segment<3>(3 * faces(f, k));
+        lambda_corners.segment<3>(3 * k) = lambda.segment<3>(3 * faces(f, k));
+      }
+      const fem::Matrix9d mixed =
+          fem::membrane_mixed_derivative(m_options.material, m_options.thickness_mm, rest_corners, x_corners);
+      const fem::Vector9d contribution = -mixed.transpose() * lambda_corners;
+      for (int k = 0; k < 3; ++k) gradient.segment<3>(3 * faces(f, k)) += contribution.segment<3>(3 * k);
+    }
+    if (m_collision->any_active()) {
+      Eigen::VectorXd collision_gradient;
+      m_collision->gradient(rest, collision_gradient);
+      gradient += collision_gradient;
+    }
+    for (int c = 0; c < gradient.size(); ++c)
+      if (!m_rest_free[static_cast<size_t>(c)]) gradient[c] = 0.0;
+    // The rest volume stays at target volume / volume ratio: with the inflated volume fixed, a uniform
+    // change of rest size barely changes the inflated shape, so without this the asked-for inflation
+    // would drift. Project out the rest-volume gradient.
+    Eigen::VectorXd w = m_model.volume_gradient(rest);
+    for (int c = 0; c < w.size(); ++c)
+      if (!m_rest_free[static_cast<size_t>(c)]) w[c] = 0.0;
+    gradient -= (gradient.dot(w) / w.squaredNorm()) * w;
+    return gradient.allFinite();
+  }
+
+  static Eigen::VectorXd lbfgs_apply(const std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>>& memory,
+                                     const Eigen::VectorXd& gradient) {
+    Eigen::VectorXd q = gradient;
+    std::vector<double> alpha(memory.size());
+    for (int i = static_cast<int>(memory.size()) - 1; i >= 0; --i) {
+      const auto& [s, y] = memory[static_cast<size_t>(i)];
+      alpha[static_cast<size_t>(i)] = s.dot(q) / y.dot(s);
+      q -= alpha[static_cast<size_t>(i)] * y;
+    }
+    if (!memory.empty()) {
+      const auto& [s, y] = memory.back();
+      q *= s.dot(y) / y.dot(y);
+    }
+    for (size_t i = 0; i < memory.size(); ++i) {
+      const auto& [s, y] = memory[i];
+      const double beta = y.dot(q) / y.dot(s);
+      q += (alpha[i] - beta) * s;
+    }
+    return q;
+  }
+
+  void record(DesignResult& result, int iteration, const SurfaceDistanceStats& stats) {
+    ConvergenceSample sample;
+    sample.time_s = now_s() - m_start;
+    sample.iteration = iteration;
+    sample.avg_error_mm = stats.avg_mm;
+    sample.max_error_mm = stats.max_mm;
+    sample.residual_norm = m_last_report.residual_norm;
+    result.log.push_back(sample);
+    if (!m_options.progress) return;
+    ProgressEvent event;
+    event.phase = iteration == 0 ? "start" : "design";
+    event.iteration = iteration;
+    event.elapsed_s = sample.time_s;
+    event.avg_error_mm = stats.avg_mm;
+    event.max_error_mm = stats.max_mm;
+    event.residual_norm = sample.residual_norm;
+    event.pressure_kpa = m_pressure / MPA_PER_KPA;
+    Positions shape;
+    const int every = std::max(1, m_options.progress_mesh_every);
+    if (iteration % every == 0) {
+      shape = rigid_align_to(unflatten(m_x), m_target.vertices);
+      event.shape = &shape;
+    }
+    m_options.progress(event);
+  }
+
+  DesignResult& finish(DesignResult& result, const Eigen::VectorXd& rest) {
+    result.rest = m_target;
+    result.rest.vertices = unflatten(rest);
+    result.inflated = rigid_align_to(unflatten(m_x), m_target.vertices);
+    result.pressure_kpa = m_pressure / MPA_PER_KPA;
+    result.volume_ratio = enclosed_volume(unflatten(m_x), m_target.faces) / rest_volume(rest);
+    const SurfaceDistanceStats stats = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
+    result.avg_error_mm = stats.avg_mm;
+    result.max_error_mm = stats.max_mm;
+    result.avg_error_rel = stats.avg_rel;
+    result.max_error_rel = stats.max_rel;
+    result.distance_energy = m_distance.value(m_x);
+    m_model.set_rest_positions(result.rest.vertices);
+    result.residual_norm = m_solver.residual(m_x, m_pressure).norm();
+    result.time_s = now_s() - m_start;
+    return result;
+  }
+
+  const TriMesh& m_target;
+  const DesignOptions& m_options;
+  double m_start;
+  TriMesh m_rest_mesh;
+  fem::BalloonModel m_model;
+  EquilibriumSolver m_solver;
+  DistanceEnergy m_distance;
+  SurfaceDistance m_surface;
+  std::unique_ptr<SelfCollision> m_collision;
+  bool m_collision_seen = false;
+  double m_target_volume;
+  std::vector<bool> m_rest_free;
+  NewtonSettings m_settings;
+  NewtonReport m_last_report;
+  Eigen::VectorXd m_x;
+  double m_pressure = 0.0;
+};
+
+std::string options_problem(const TriMesh& target, const DesignOptions& options) {
+  if (target.vertex_count() < 4 || target.face_count() < 4) return "the target mesh is empty";
+  if (auto problem = material_problem(options.material); !problem.empty()) return problem;
+  if (!(options.thickness_mm > 0.0) || !std::isfinite(options.thickness_mm)) return "thickness must be positive (mm)";
+  if (options.scale > 0) {
+    if (!(options.scale < 1.0)) return "scale must be below 1: the balloon starts smaller than the target";
+  } else if (!(options.volume_ratio > 1.0) || !std::isfinite(options.volume_ratio)) {
+    return "volume ratio must be a number above 1";
+  }
+  if (!(enclosed_volume(target.vertices, target.faces) > 0.0)) return "the target encloses no positive volume";
+  for (int v : options.nozzle_vertices)
+    if (v < 0 || v >= target.vertex_count()) return "nozzle vertex " + std::to_string(v) + " does not exist";
+  return "";
+}
+
+}  // namespace
+
+DesignResult design_balloon(const TriMesh& target, const DesignOptions& options) {
+  if (auto problem = options_problem(target, options); !problem.empty()) {
+    DesignResult result;
+    result.method = options.method;
+    result.message = problem;
+    result.rest = target;
+    result.inflated = target.vertices;
+    return result;
+  }
+  AdjointDesign design(target, options);
+  return design.run();
+}
+
+}  // namespace balloon

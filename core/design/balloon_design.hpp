@@ -1,0 +1,69 @@
+#pragma once
+/// Inverse design (paper sec. 5): the rest shape whose inflated equilibrium is closest to a target.
+/// The target must already be prepared (closed, manifold, mm; see target_preparation.hpp).
+#include <string>
+#include <vector>
+
+#include "material/material.hpp"
+#include "mesh/tri_mesh.hpp"
+#include "progress.hpp"
+
+namespace balloon {
+
+enum class DesignMethod { Adjoint, AugmentedLagrangian };
+
+/// "adjoint" or "alm".
+std::string design_method_name(DesignMethod method);
+Result<DesignMethod> parse_design_method(const std::string& name);
+
+struct DesignOptions {
+  Material material;
+  double thickness_mm = 0.5;            ///< rest membrane thickness (mm)
+  /// How far the balloon inflates. The start is the target scaled about its centroid by
+  /// `scale` when scale > 0, else by volume_ratio^(-1/3); the pressure is the one that inflates that
+  /// start to the target's volume (paper sec. 5.2, "Inflation Pressure").
+  double volume_ratio = 8.0;            ///< target volume / rest volume of the start
+  double scale = 0.0;                   ///< linear scale of the start (0 = use volume_ratio)
+  DesignMethod method = DesignMethod::Adjoint;
+  std::vector<int> nozzle_vertices;     ///< rest vertices held at their start positions (empty = no nozzle)
+  double max_time_s = 0.0;              ///< wall-time budget (s); 0 = none
+  int max_iterations = 200;             ///< outer iterations
+  double k_length = 1.0, k_bending = 1.0;  ///< E_dist coefficients (eq. 18)
+  int progress_mesh_every = 5;          ///< attach the inflated mesh to every K-th progress event
+  ProgressCallback progress;            ///< optional; phases "start", "design"
+  const CancelToken* cancel = nullptr;  ///< optional; checked between iterations
+};
+
+/// One row of the convergence log: error against run time.
+struct ConvergenceSample {
+  double time_s = 0.0;
+  int iteration = 0;
+  double avg_error_mm = 0.0;
+  double max_error_mm = 0.0;
+  double residual_norm = 0.0;  ///< force residual of the inflated shape (N)
+};
+
+struct DesignResult {
+  bool converged = false;
+  std::string message;                 ///< why it stopped
+  DesignMethod method = DesignMethod::Adjoint;
+  TriMesh rest;                        ///< the balloon to fabricate (mm)
+  Positions inflated;                  ///< its predicted inflated shape, rigidly aligned to the target (mm)
+  double pressure_kpa = 0.0;
+  double volume_ratio = 0.0;           ///< inflated volume / rest volume
+  int iterations = 0;
+  double time_s = 0.0;
+  double avg_error_mm = 0.0, max_error_mm = 0.0;  ///< inflated vertex to target surface (mm)
+  double avg_error_rel = 0.0, max_error_rel = 0.0;  ///< the same over the target's bounding-box diagonal
+  double bbox_diag_mm = 0.0;
+  double baseline_avg_error_mm = 0.0, baseline_max_error_mm = 0.0;  ///< the start (downscaled target) inflated
+  double distance_energy = 0.0;        ///< E_dist at the end (mm)
+  double residual_norm = 0.0;          ///< force residual of the inflated shape (N)
+  std::vector<std::string> active_terms;  ///< e.g. "distance", "max_volume", "rest_bending", "collision", "nozzle"
+  std::vector<ConvergenceSample> log;
+};
+
+/// Designs the rest shape for `target`. Never throws for bad numerics: failures are in the result.
+DesignResult design_balloon(const TriMesh& target, const DesignOptions& options);
+
+}  // namespace balloon
