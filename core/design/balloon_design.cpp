@@ -1,6 +1,8 @@
 #include "design/balloon_design.hpp"
 
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -89,7 +91,6 @@ class AdjointDesign {
     result.baseline_avg_error_mm = baseline.avg_mm;
     result.baseline_max_error_mm = baseline.max_mm;
     record(result, 0, baseline);
-
     Eigen::VectorXd gradient;
     double objective = objective_value(rest, m_x);
     if (!objective_gradient(rest, gradient)) {
@@ -127,7 +128,11 @@ class AdjointDesign {
         trial_rest = keep_rest_volume(rest + t * direction, rest_volume(rest));
         trial_x = m_x;
         trial_pressure = m_pressure;
-        if (!equilibrium(trial_rest, trial_x, trial_pressure)) {
+        const bool balanced = equilibrium(trial_rest, trial_x, trial_pressure);
+        if (std::getenv("BALLOON_DEBUG_DESIGN"))
+          std::fprintf(stderr, "  it %d trial %d t=%.3g newton %d %s\n", iteration, k, t, m_last_report.iterations,
+                       m_last_report.message.c_str());
+        if (!balanced) {
           if (stopped()) break;
           continue;
         }
