@@ -19,9 +19,13 @@ struct Command {
 const Command COMMANDS[] = {
     {"simulate", "inflate a rest mesh to equilibrium under a pressure or to a volume ratio",
      balloon::cli::run_simulate_command},
+    {"design", "find the rest shape whose inflation matches a target; writes rest, inflated, mold, report",
+     balloon::cli::run_design_command},
     {"submit", "queue a simulate job and print its id", balloon::cli::run_submit_command},
     {"jobs", "list, show, watch, cancel jobs and fetch results", balloon::cli::run_jobs_command},
     {"materials", "list, show, delete and store materials", balloon::cli::run_materials_command},
+    {"fit-material", "fit rubber laws to measurements (bulge or stress tables); --name stores the fit",
+     balloon::cli::run_fit_material_command},
     {"mesh", "make meshes (`balloon mesh sphere --radius MM --subdivisions K --out FILE`)",
      balloon::cli::run_mesh_command},
 };

@@ -172,7 +172,7 @@ class AdjointDesign {
       const Eigen::VectorXd change = new_gradient - gradient;
       if (step.dot(change) > 1e-12 * step.norm() * change.norm()) {
         memory.emplace_back(step, change);
-        if (memory.size() > 10) memory.pop_front();
+        if (memory.size() > 30) memory.pop_front();
       }
       gradient = new_gradient;
       const SurfaceDistanceStats stats = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);

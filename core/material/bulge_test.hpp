@@ -73,12 +73,37 @@ BulgeCurve bulge_pressure_sweep(const BulgeTestOptions& options, const std::vect
 /// height h = a sqrt(rho^2 - 1) has volume pi h (3 a^2 + h^2) / 6. Used to size volume sweeps.
 double bulge_cap_volume(double radius_mm, double extension_ratio);
 
+/// A pressure-extension curve of the FEM bulge test: increasing extension ratios (from 1) and pressures.
+struct BulgeResponse {
+  std::vector<double> extension_ratio;  ///< #points, strictly increasing, first = 1 (flat disc)
+  std::vector<double> pressure_kpa;     ///< #points (kPa), first = 0
+  /// Linear interpolation at `extension_ratio`: 0 at or below 1, NaN beyond the last point.
+  double pressure_at(double extension_ratio) const;
+};
+
+/// Volume-controlled sweep from the flat disc in steps of about 0.02 in extension ratio (estimated from the
+/// spherical cap) until `max_extension_ratio` is passed or the sweep fails.
+BulgeResponse fem_bulge_response(const Material& material, double radius_mm, double thickness_mm,
+                                 double max_extension_ratio, int rings = 6);
+
 /// Pressures (kPa) of the FEM bulge test at each extension ratio of `set` (a Bulge set), interpolated
 /// linearly in a volume-controlled sweep that runs past the largest measured ratio; NaN where the sweep
 /// cannot reach a ratio. `rings` sets the mesh resolution (coarse keeps fits fast).
 std::vector<double> fem_bulge_pressures(const Material& material, const MeasurementSet& set, int rings = 6);
 
-/// fem_bulge_pressures as a FitOptions::bulge_model.
+/// fem_bulge_pressures as a FitOptions::bulge_model. Exact but slow inside fit_material (one FEM sweep per
+/// model evaluation: about a minute for a Hart-Smith fit of 10 points); see fit_material_with_fem_bulge.
 BulgeModel fem_bulge_model(int rings = 6);
+
+/// fit_material() with bulge sets simulated by the FEM disc, made fast by a corrected spherical cap: the
+/// bulge model inside the least squares is spherical_cap_bulge_pressures(m) * c(rho), where the correction
+/// c = p_FEM / p_cap is computed by one FEM sweep at the current fit; refit, recompute c at the new fit, and
+/// repeat until the model the fit used agrees with the FEM at the fitted material within 0.5% of the largest
+/// measured pressure (at most `max_rounds` refits; the message says which). The reported residuals are
+/// then FEM residuals. The search neglects how c depends on the material, so along a flat valley of the
+/// cost (G against k2 for Hart-Smith) it can stop at a point a little off the FEM least-squares optimum.
+/// Sets of other kinds are fitted as by fit_material. `options.bulge_model` is ignored.
+Result<FitResult> fit_material_with_fem_bulge(MaterialModel model, const std::vector<MeasurementSet>& sets,
+                                              const FitOptions& options = {}, int rings = 16, int max_rounds = 10);
 
 }  // namespace balloon

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <random>
 
+#include "jobs/design_job.hpp"
 #include "jobs/simulate_job.hpp"
 #include "mesh/mesh_io.hpp"
 #include "store/mesh_blob.hpp"
@@ -21,6 +22,7 @@ namespace v1 = balloon::v1;
 using store::JobState;
 
 constexpr const char* KIND_SIMULATE = "simulate";
+constexpr const char* KIND_DESIGN = "design";
 constexpr int MAX_PAGE_SIZE = 1000;
 constexpr int DEFAULT_PAGE_SIZE = 100;
 constexpr double SHAPE_CHECKPOINT_INTERVAL_S = 1.0;  // stored shapes are big: at most one a second per job
@@ -38,7 +40,7 @@ v1::JobState to_proto(JobState state) {
 
 v1::JobKind kind_to_proto(const std::string& kind) {
   if (kind == KIND_SIMULATE) return v1::JOB_KIND_SIMULATE;
-  if (kind == "design") return v1::JOB_KIND_DESIGN;
+  if (kind == KIND_DESIGN) return v1::JOB_KIND_DESIGN;
   if (kind == "fit_material") return v1::JOB_KIND_FIT_MATERIAL;
   return v1::JOB_KIND_UNSPECIFIED;
 }
@@ -128,6 +130,71 @@ static LoadedSimulate load_simulate(const v1::SimulateJob& job, const std::strin
   return loaded;
 }
 
+/// A decoded, checked design job, or an error with the status code it deserves.
+struct LoadedDesign {
+  std::optional<jobs::DesignInput> input;
+  StatusCode code = StatusCode::Ok;
+  std::string error;
+};
+
+static LoadedDesign load_design(const v1::DesignJob& job, const std::string& tenant, int max_vertices,
+                                MaterialHandler& materials) {
+  LoadedDesign loaded;
+  auto failure = [&](StatusCode code, std::string message) {
+    loaded.code = code;
+    loaded.error = std::move(message);
+    return loaded;
+  };
+  if (job.target_mesh().data().empty()) return failure(StatusCode::InvalidArgument, "target_mesh is empty");
+  const std::string extension = mesh_format_extension(job.target_mesh().format());
+  if (extension.empty())
+    return failure(StatusCode::InvalidArgument, "target_mesh.format is missing or unknown (OBJ, STL, PLY, OFF, GLTF, GLB)");
+  Result<TriMesh> mesh = read_mesh_from_memory(job.target_mesh().data(), extension);
+  if (!mesh) return failure(StatusCode::InvalidArgument, "target_mesh: " + mesh.error());
+  if (max_vertices > 0 && mesh->vertex_count() > max_vertices)
+    return failure(StatusCode::ResourceExhausted, "target_mesh has " + std::to_string(mesh->vertex_count()) +
+                                                      " vertices, over this server's limit of " +
+                                                      std::to_string(max_vertices));
+  Result<Material> material = materials.resolve(tenant, job.material());
+  if (!material) return failure(StatusCode::InvalidArgument, "material: " + material.error());
+
+  jobs::DesignParameters parameters;
+  parameters.thickness_mm = job.thickness_mm() == 0.0 ? jobs::DEFAULT_THICKNESS_MM : job.thickness_mm();
+  parameters.size_mm = job.size_mm();
+  // On the wire 0 means the default and < 0 "never remesh" (proto3 has no unset ints); here 0 never remeshes.
+  parameters.resolution = job.resolution() == 0 ? jobs::DEFAULT_DESIGN_RESOLUTION : std::max(0, job.resolution());
+  if (job.inflation_case() == v1::DesignJob::kScale) parameters.scale = job.scale();
+  if (job.inflation_case() == v1::DesignJob::kVolumeRatio) parameters.volume_ratio = job.volume_ratio();
+  parameters.method = job.method();
+  parameters.nozzle = job.nozzle();
+  parameters.max_time_s = job.max_time_s();
+  parameters.tolerance_samples = job.tolerance_samples();
+  if (max_vertices > 0 && parameters.resolution > max_vertices)
+    return failure(StatusCode::ResourceExhausted, "resolution " + std::to_string(parameters.resolution) +
+                                                      " is over this server's limit of " +
+                                                      std::to_string(max_vertices) + " vertices");
+  Result<jobs::DesignInput> input = jobs::prepare_design(std::move(*mesh), *material, parameters);
+  if (!input) {
+    std::string message = input.error();
+    if (message.rfind("mesh: ", 0) == 0) message = "target_" + message;
+    return failure(StatusCode::InvalidArgument, message);
+  }
+  loaded.input = std::move(*input);
+  return loaded;
+}
+
+static std::string design_summary(const jobs::DesignInput& input) {
+  std::string summary = "design " + std::to_string(input.target.mesh.vertex_count()) + " vertices, " +
+                        (input.material.name.empty() ? material_spec(input.material) : input.material.name) + ", " +
+                        format_number(input.parameters.thickness_mm) + " mm, " + design_method_name(input.method) + ", ";
+  if (input.parameters.scale)
+    summary += "scale " + format_number(*input.parameters.scale);
+  else
+    summary += "V/V0=" + format_number(input.parameters.volume_ratio ? *input.parameters.volume_ratio
+                                                                     : DesignOptions{}.volume_ratio);
+  return summary;
+}
+
 static std::string simulate_summary(const jobs::SimulateInput& input) {
   std::string summary = "simulate " + std::to_string(input.rest.vertex_count()) + " vertices, " +
                         (input.material.name.empty() ? material_spec(input.material) : input.material.name) + ", " +
@@ -209,10 +276,7 @@ ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobReques
   const v1::JobSpec& spec = request.spec();
   switch (spec.kind_case()) {
     case v1::JobSpec::kSimulate: break;
-    case v1::JobSpec::kDesign:
-      return ServiceStatus::error(StatusCode::Unimplemented,
-                                  "design jobs are not available yet (the inverse-design optimizer has not landed); "
-                                  "simulate jobs are");
+    case v1::JobSpec::kDesign: break;
     case v1::JobSpec::kFitMaterial:
       return ServiceStatus::error(StatusCode::Unimplemented, "material-fit jobs are not available yet");
     case v1::JobSpec::KIND_NOT_SET:
@@ -223,15 +287,28 @@ ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobReques
   if (!std::isfinite(spec.time_limit_s()) || spec.time_limit_s() < 0.0)
     return ServiceStatus::error(StatusCode::InvalidArgument, "time_limit_s must be a finite number >= 0 (s)");
 
-  LoadedSimulate loaded = load_simulate(spec.simulate(), caller.tenant, m_options.max_mesh_vertices, m_materials);
-  if (!loaded.input) return ServiceStatus::error(loaded.code, loaded.error);
-
   // Store the material as resolved now: a stored material edited later must not change a queued job.
   v1::JobSpec stored = spec;
-  if (spec.simulate().material().kind_case() == v1::MaterialRef::kName) {
-    const std::vector<std::string> presets = preset_names();
-    if (std::find(presets.begin(), presets.end(), spec.simulate().material().name()) == presets.end())
+  const std::vector<std::string> presets = preset_names();
+  const auto is_stored_name = [&](const v1::MaterialRef& ref) {
+    return ref.kind_case() == v1::MaterialRef::kName &&
+           std::find(presets.begin(), presets.end(), ref.name()) == presets.end();
+  };
+  std::string kind, summary;
+  if (spec.kind_case() == v1::JobSpec::kDesign) {
+    LoadedDesign loaded = load_design(spec.design(), caller.tenant, m_options.max_mesh_vertices, m_materials);
+    if (!loaded.input) return ServiceStatus::error(loaded.code, loaded.error);
+    if (is_stored_name(spec.design().material()))
+      stored.mutable_design()->mutable_material()->set_spec(material_spec(loaded.input->material));
+    kind = KIND_DESIGN;
+    summary = design_summary(*loaded.input);
+  } else {
+    LoadedSimulate loaded = load_simulate(spec.simulate(), caller.tenant, m_options.max_mesh_vertices, m_materials);
+    if (!loaded.input) return ServiceStatus::error(loaded.code, loaded.error);
+    if (is_stored_name(spec.simulate().material()))
       stored.mutable_simulate()->mutable_material()->set_spec(material_spec(loaded.input->material));
+    kind = KIND_SIMULATE;
+    summary = simulate_summary(*loaded.input);
   }
 
   if (!m_queue.reserve())
@@ -240,10 +317,10 @@ ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobReques
   store::JobRecord record;
   record.job_id = new_job_id();
   record.owner = caller.tenant;
-  record.kind = KIND_SIMULATE;
+  record.kind = kind;
   record.state = JobState::Queued;
   record.priority = spec.priority();
-  record.summary = simulate_summary(*loaded.input);
+  record.summary = summary;
   record.created_ms = now_ms();
   if (!stored.SerializeToString(&record.spec)) {
     m_queue.release_reservation();
@@ -485,12 +562,14 @@ void JobHandler::run_job(std::int64_t row_id) {
   publish(record->job_id, state_event(record->job_id, v1::JOB_STATE_RUNNING,
                                       "started (attempt " + std::to_string(record->attempts) + ")"));
   try {
-    if (!spec_ok || spec.kind_case() != v1::JobSpec::kSimulate) {
+    if (spec_ok && spec.kind_case() == v1::JobSpec::kSimulate) {
+      run_simulate_job(*record, spec, *active);
+    } else if (spec_ok && spec.kind_case() == v1::JobSpec::kDesign) {
+      run_design_job(*record, spec, *active);
+    } else {
       const std::string error = spec_ok ? "this server cannot run this kind of job" : "the stored job spec is unreadable";
       m_jobs.mark_failed(row_id, error);
       close_watchers(record->job_id, state_event(record->job_id, v1::JOB_STATE_FAILED, error));
-    } else {
-      run_simulate_job(*record, spec, *active);
     }
   } catch (const std::exception& error) {
     const std::string message = std::string("internal error: ") + error.what();
@@ -512,56 +591,10 @@ void JobHandler::run_simulate_job(const store::JobRecord& record, const v1::JobS
     return;
   }
   const jobs::SimulateInput& input = *loaded.input;
-  {
-    auto triangles = std::make_shared<std::vector<std::uint32_t>>();
-    triangles->reserve(static_cast<std::size_t>(input.rest.faces.size()));
-    for (Eigen::Index i = 0; i < input.rest.faces.size(); ++i)
-      triangles->push_back(static_cast<std::uint32_t>(input.rest.faces.data()[i]));
-    std::lock_guard lock(m_watch_mutex);
-    m_connectivity[record.job_id] = std::move(triangles);
-  }
-
-  const int mesh_every = spec.progress_mesh_every() != 0 ? spec.progress_mesh_every() : m_options.progress_mesh_every;
-  int shape_events = 0;
-  std::chrono::steady_clock::time_point last_checkpoint{}, last_shape_checkpoint{};
+  set_connectivity(record.job_id, input.rest.faces);
   jobs::RunControls controls;
   controls.cancel = &active.token;
-  controls.progress = [&](const ProgressEvent& progress) {
-    v1::JobEvent event;
-    event.set_job_id(record.job_id);
-    event.set_state(v1::JOB_STATE_RUNNING);
-    event.set_time_ms(now_ms());
-    store::ProgressRecord checkpoint;
-    checkpoint.phase = progress.phase;
-    checkpoint.iteration = progress.iteration;
-    checkpoint.elapsed_s = progress.elapsed_s;
-    checkpoint.residual_norm = progress.residual_norm;
-    checkpoint.pressure_kpa = progress.pressure_kpa;
-    checkpoint.avg_error_mm = progress.avg_error_mm;
-    checkpoint.max_error_mm = progress.max_error_mm;
-    checkpoint.recorded_ms = event.time_ms();
-    fill_progress(checkpoint, event.mutable_progress());
-    if (progress.shape != nullptr && mesh_every > 0 && shape_events++ % mesh_every == 0) {
-      v1::IntermediateMesh* mesh = event.mutable_mesh();
-      mesh->set_vertex_count(static_cast<std::uint32_t>(progress.shape->rows()));
-      mesh->set_iteration(progress.iteration);
-      mesh->mutable_positions_mm()->Reserve(static_cast<int>(progress.shape->size()));
-      for (Eigen::Index i = 0; i < progress.shape->size(); ++i)
-        mesh->add_positions_mm(static_cast<float>(progress.shape->data()[i]));
-    }
-    const auto now = std::chrono::steady_clock::now();
-    if (std::chrono::duration<double>(now - last_checkpoint).count() >= m_options.checkpoint_interval_s) {
-      std::string shape;
-      if (progress.shape != nullptr &&
-          std::chrono::duration<double>(now - last_shape_checkpoint).count() >= SHAPE_CHECKPOINT_INTERVAL_S) {
-        shape = store::encode_positions_f32(*progress.shape);
-        last_shape_checkpoint = now;
-      }
-      m_jobs.append_progress(record.row_id, checkpoint, shape);
-      last_checkpoint = now;
-    }
-    publish(record.job_id, std::move(event));
-  };
+  controls.progress = progress_publisher(record, spec);
 
   const jobs::SimulateOutcome outcome = jobs::run_simulate(input, controls);
   if (active.stop_reason != static_cast<int>(StopReason::None)) {
@@ -577,6 +610,107 @@ void JobHandler::run_simulate_job(const store::JobRecord& record, const v1::JobS
   const std::string message = outcome.result.converged
                                   ? "completed: converged in " + format_number(outcome.result.time_s) + " s"
                                   : "completed without converging: " + outcome.result.message;
+  log("job " + record.job_id + " " + message);
+  v1::JobEvent done = state_event(record.job_id, v1::JOB_STATE_COMPLETED, message);
+  done.set_converged(outcome.result.converged);
+  close_watchers(record.job_id, std::move(done));
+}
+
+void JobHandler::set_connectivity(const std::string& job_id, const Faces& faces) {
+  auto triangles = std::make_shared<std::vector<std::uint32_t>>();
+  triangles->reserve(static_cast<std::size_t>(faces.size()));
+  for (Eigen::Index i = 0; i < faces.size(); ++i) triangles->push_back(static_cast<std::uint32_t>(faces.data()[i]));
+  std::lock_guard lock(m_watch_mutex);
+  m_connectivity[job_id] = std::move(triangles);
+}
+
+ProgressCallback JobHandler::progress_publisher(const store::JobRecord& record, const v1::JobSpec& spec) {
+  const int mesh_every = spec.progress_mesh_every() != 0 ? spec.progress_mesh_every() : m_options.progress_mesh_every;
+  // The callback is copied into the solver's options: its counters live behind one shared pointer.
+  struct State {
+    int shape_events = 0;
+    std::chrono::steady_clock::time_point last_checkpoint{}, last_shape_checkpoint{};
+  };
+  auto state = std::make_shared<State>();
+  const std::int64_t row_id = record.row_id;
+  const std::string job_id = record.job_id;
+  return [this, state, mesh_every, row_id, job_id](const ProgressEvent& progress) {
+    v1::JobEvent event;
+    event.set_job_id(job_id);
+    event.set_state(v1::JOB_STATE_RUNNING);
+    event.set_time_ms(now_ms());
+    store::ProgressRecord checkpoint;
+    checkpoint.phase = progress.phase;
+    checkpoint.iteration = progress.iteration;
+    checkpoint.elapsed_s = progress.elapsed_s;
+    checkpoint.residual_norm = progress.residual_norm;
+    checkpoint.pressure_kpa = progress.pressure_kpa;
+    checkpoint.avg_error_mm = progress.avg_error_mm;
+    checkpoint.max_error_mm = progress.max_error_mm;
+    checkpoint.recorded_ms = event.time_ms();
+    fill_progress(checkpoint, event.mutable_progress());
+    if (progress.shape != nullptr && mesh_every > 0 && state->shape_events++ % mesh_every == 0) {
+      v1::IntermediateMesh* mesh = event.mutable_mesh();
+      mesh->set_vertex_count(static_cast<std::uint32_t>(progress.shape->rows()));
+      mesh->set_iteration(progress.iteration);
+      mesh->mutable_positions_mm()->Reserve(static_cast<int>(progress.shape->size()));
+      for (Eigen::Index i = 0; i < progress.shape->size(); ++i)
+        mesh->add_positions_mm(static_cast<float>(progress.shape->data()[i]));
+    }
+    const auto now = std::chrono::steady_clock::now();
+    if (std::chrono::duration<double>(now - state->last_checkpoint).count() >= m_options.checkpoint_interval_s) {
+      std::string shape;
+      if (progress.shape != nullptr &&
+          std::chrono::duration<double>(now - state->last_shape_checkpoint).count() >= SHAPE_CHECKPOINT_INTERVAL_S) {
+        shape = store::encode_positions_f32(*progress.shape);
+        state->last_shape_checkpoint = now;
+      }
+      m_jobs.append_progress(row_id, checkpoint, shape);
+      state->last_checkpoint = now;
+    }
+    publish(job_id, std::move(event));
+  };
+}
+
+void JobHandler::run_design_job(const store::JobRecord& record, const v1::JobSpec& spec, ActiveJob& active) {
+  // The limit on vertices was applied at submit time; a job accepted then runs now even if the limit shrank.
+  LoadedDesign loaded = load_design(spec.design(), record.owner, 0, m_materials);
+  if (!loaded.input) {
+    m_jobs.mark_failed(record.row_id, loaded.error);
+    log("job " + record.job_id + " failed: " + loaded.error);
+    close_watchers(record.job_id, state_event(record.job_id, v1::JOB_STATE_FAILED, loaded.error));
+    return;
+  }
+  const jobs::DesignInput& input = *loaded.input;
+  set_connectivity(record.job_id, input.target.mesh.faces);
+  jobs::RunControls controls;
+  controls.cancel = &active.token;
+  controls.progress = progress_publisher(record, spec);
+
+  const jobs::DesignOutcome outcome = jobs::run_design(input, controls);
+  if (active.stop_reason != static_cast<int>(StopReason::None)) {
+    finish_stopped(record, active);
+    return;
+  }
+  if (outcome.result.rest.vertex_count() == 0) {
+    const std::string error = "the design produced no rest shape: " + outcome.result.message;
+    m_jobs.mark_failed(record.row_id, error);
+    log("job " + record.job_id + " failed: " + error);
+    close_watchers(record.job_id, state_event(record.job_id, v1::JOB_STATE_FAILED, error));
+    return;
+  }
+  store::ResultRecord result;
+  result.converged = outcome.result.converged;
+  result.rest_mesh = store::encode_mesh_blob(outcome.result.rest);
+  result.inflated_mesh = store::encode_mesh_blob(TriMesh{outcome.result.inflated, outcome.result.rest.faces});
+  result.report_json = outcome.report_json;
+  if (!m_jobs.mark_completed(record.row_id, result)) return;  // cancelled as it finished: that already published
+  char errors[128];
+  std::snprintf(errors, sizeof(errors), "avg error %.3g mm (%.2g%% of %.3g mm)", outcome.result.avg_error_mm,
+                100.0 * outcome.result.avg_error_rel, outcome.result.bbox_diag_mm);
+  const std::string message = (outcome.result.converged ? "completed: converged in " : "completed without converging in ") +
+                              format_number(outcome.result.time_s) + " s, " + errors +
+                              (outcome.result.converged ? std::string() : ": " + outcome.result.message);
   log("job " + record.job_id + " " + message);
   v1::JobEvent done = state_event(record.job_id, v1::JOB_STATE_COMPLETED, message);
   done.set_converged(outcome.result.converged);

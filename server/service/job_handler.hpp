@@ -75,6 +75,13 @@ class JobHandler {
   void run_job(std::int64_t row_id);
   /// Runs a simulate job to its end state (completed, failed, cancelled or re-queued) and publishes it.
   void run_simulate_job(const store::JobRecord& record, const balloon::v1::JobSpec& spec, ActiveJob& active);
+  /// Runs a design job (jobs/design_job) to its end state and publishes it, like run_simulate_job.
+  void run_design_job(const store::JobRecord& record, const balloon::v1::JobSpec& spec, ActiveJob& active);
+  /// The triangles the first intermediate mesh of a job's watchers carries.
+  void set_connectivity(const std::string& job_id, const Faces& faces);
+  /// A progress callback that publishes a running job's events (with the intermediate mesh every K
+  /// events) and checkpoints them in the store at most every checkpoint_interval_s.
+  ProgressCallback progress_publisher(const store::JobRecord& record, const balloon::v1::JobSpec& spec);
   /// Records a job that stopped early: cancelled (already stored), timed out, or re-queued at shutdown.
   void finish_stopped(const store::JobRecord& record, ActiveJob& active);
   bool acquire_store_lock();
