@@ -60,7 +60,7 @@ class AdjointDesign {
         m_distance(target.vertices, target.faces, options.k_length, options.k_bending),
         m_surface(target),
         m_target_volume(enclosed_volume(target.vertices, target.faces)) {
-    m_settings.relative_tolerance = 1e-9;
+    m_settings.relative_tolerance = 1e-7;
     m_settings.max_iterations = 60;
     m_settings.cancel = options.cancel;
     m_settings.deadline_s = options.max_time_s > 0 ? m_start + options.max_time_s : 0.0;
@@ -121,13 +121,18 @@ class AdjointDesign {
       double t = largest > limit ? limit / largest : 1.0;
       if (memory.empty()) t = std::min(t, 0.002 * result.bbox_diag_mm / std::max(largest, 1e-300));
       const double slope = direction.dot(gradient);
+      // First-order response of the equilibrium to the rest step, from the factorization the gradient
+      // just used: each trial starts Newton a second-order distance from its solution.
+      Eigen::VectorXd response;
+      double pressure_response = 0.0;
+      linear_response(rest, direction, response, pressure_response);
       bool accepted = false;
       Eigen::VectorXd trial_rest, trial_x;
       double trial_pressure = 0.0, trial_objective = 0.0;
       for (int k = 0; k < 12; ++k, t *= 0.5) {
         trial_rest = keep_rest_volume(rest + t * direction, rest_volume(rest));
-        trial_x = m_x;
-        trial_pressure = m_pressure;
+        trial_x = m_x + t * response;
+        trial_pressure = m_pressure + t * pressure_response;
         const bool balanced = equilibrium(trial_rest, trial_x, trial_pressure);
         if (std::getenv("BALLOON_DEBUG_DESIGN"))
           std::fprintf(stderr, "  it %d trial %d t=%.3g newton %d %s\n", iteration, k, t, m_last_report.iterations,
@@ -321,6 +326,36 @@ class AdjointDesign {
       if (!m_rest_free[static_cast<size_t>(c)]) w[c] = 0.0;
     gradient -= (gradient.dot(w) / w.squaredNorm()) * w;
     return gradient.allFinite();
+  }
+
+  /// d(x, p) for a rest change `direction` at the current equilibrium, using the current factorization:
+  /// [K -v; -v^T 0] [dx; dp] = [-(d grad_x W / d rest) direction; 0].
+  void linear_response(const Eigen::VectorXd& rest, const Eigen::VectorXd& direction, Eigen::VectorXd& dx,
+                       double& dp) const {
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(rest.size());
+    const Faces& faces = m_target.faces;
+    for (int f = 0; f < faces.rows(); ++f) {
+      fem::Vector9d rest_corners, x_corners, step_corners;
+      for (int k = 0; k < 3; ++k) {
+        rest_corners.segment<3>(3 * k) = rest.segment<3>(3 * faces(f, k));
+        x_corners.segment<3>(3 * k) = m_x.segment<3>(3 * faces(f, k));
+        step_corners.segment<3>(3 * k) = direction.segment<3>(3 * faces(f, k));
+      }
+      const fem::Vector9d change =
+          fem::membrane_mixed_derivative(m_options.material, m_options.thickness_mm, rest_corners, x_corners) *
+          step_corners;
+      for (int k = 0; k < 3; ++k) rhs.segment<3>(3 * faces(f, k)) -= change.segment<3>(3 * k);
+    }
+    const Eigen::VectorXd v = m_model.volume_gradient(m_x);
+    const Eigen::VectorXd a = m_solver.solve_with_factorization(rhs);
+    const Eigen::VectorXd b = m_solver.solve_with_factorization(v);
+    const double vb = v.dot(b);
+    dp = std::abs(vb) > 0.0 ? -v.dot(a) / vb : 0.0;
+    dx = a + dp * b;
+    if (!dx.allFinite()) {
+      dx.setZero(rest.size());
+      dp = 0.0;
+    }
   }
 
   static Eigen::VectorXd lbfgs_apply(const std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>>& memory,
