@@ -1,5 +1,7 @@
 #include "design/balloon_design.hpp"
 
+#include <Eigen/CholmodSupport>
+#include <Eigen/SparseCore>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -98,6 +100,7 @@ class AdjointDesign {
       return finish(result, rest);
     }
     const double initial_objective = objective;
+    build_preconditioner();
     std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> memory;  // (s, y) pairs for L-BFGS
     int small_decreases = 0;
     result.message = "iteration limit reached";
@@ -111,6 +114,8 @@ class AdjointDesign {
         break;
       }
       Eigen::VectorXd direction = -lbfgs_apply(memory, gradient);
+      for (int c = 0; c < direction.size(); ++c)
+        if (!m_rest_free[static_cast<size_t>(c)]) direction[c] = 0.0;
       if (!(direction.dot(gradient) < 0.0)) {
         memory.clear();
         direction = -gradient;
@@ -358,8 +363,25 @@ class AdjointDesign {
     }
   }
 
-  static Eigen::VectorXd lbfgs_apply(const std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>>& memory,
-                                     const Eigen::VectorXd& gradient) {
+  /// L-BFGS's initial inverse Hessian: the Gauss-Newton Hessian of E_dist at the start's inflation,
+  /// factorized once. The rest-to-inflated map is close to a scaling, so this is the shape of the
+  /// objective's curvature in rest coordinates; L-BFGS corrects the rest.
+  void build_preconditioner() {
+    Eigen::SparseMatrix<double> hessian = m_distance.hessian(m_x, DistanceHessian::GaussNewton);
+    const double shift = 1e-3 * hessian.diagonal().mean();
+    for (int c = 0; c < hessian.rows(); ++c) hessian.coeffRef(c, c) += shift;
+    m_preconditioner = std::make_unique<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>>>(hessian);
+    if (m_preconditioner->info() != Eigen::Success) m_preconditioner.reset();
+  }
+
+  Eigen::VectorXd precondition(const Eigen::VectorXd& q) const {
+    if (!m_preconditioner) return q;
+    Eigen::VectorXd r = m_preconditioner->solve(q);
+    return r.allFinite() ? r : q;
+  }
+
+  Eigen::VectorXd lbfgs_apply(const std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>>& memory,
+                              const Eigen::VectorXd& gradient) const {
     Eigen::VectorXd q = gradient;
     std::vector<double> alpha(memory.size());
     for (int i = static_cast<int>(memory.size()) - 1; i >= 0; --i) {
@@ -367,9 +389,10 @@ class AdjointDesign {
       alpha[static_cast<size_t>(i)] = s.dot(q) / y.dot(s);
       q -= alpha[static_cast<size_t>(i)] * y;
     }
+    q = precondition(q);
     if (!memory.empty()) {
       const auto& [s, y] = memory.back();
-      q *= s.dot(y) / y.dot(y);
+      q *= s.dot(y) / y.dot(precondition(y));
     }
     for (size_t i = 0; i < memory.size(); ++i) {
       const auto& [s, y] = memory[i];
@@ -432,6 +455,7 @@ class AdjointDesign {
   DistanceEnergy m_distance;
   SurfaceDistance m_surface;
   std::unique_ptr<SelfCollision> m_collision;
+  std::unique_ptr<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>>> m_preconditioner;
   bool m_collision_seen = false;
   double m_target_volume;
   std::vector<bool> m_rest_free;

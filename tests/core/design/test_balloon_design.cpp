@@ -36,6 +36,7 @@ TEST(BalloonDesign, RecoversTheBalloonOfAnInflatedEllipsoid) {
   EXPECT_GT(design.baseline_avg_error_mm, 10.0 * design.avg_error_mm) << design.message;
   EXPECT_LT(design.avg_error_rel, 1e-3) << design.message << " after " << design.iterations << " iterations";
   EXPECT_NEAR(design.volume_ratio, 6.0, 1e-3);
+  EXPECT_TRUE(design.converged) << design.message;
   std::printf("ellipsoid design: %d iterations, %.2f s, avg error %.3g mm (baseline %.3g mm), %s\n", design.iterations,
               design.time_s, design.avg_error_mm, design.baseline_avg_error_mm, design.message.c_str());
 }
