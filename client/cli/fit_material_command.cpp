@@ -1,7 +1,6 @@
 /// `balloon fit-material`: fit rubber laws to measurement files, print, plot, and optionally store the fit
-/// in the service's material library. The fit itself runs in-process through the job layer
-/// (server/jobs/fit_job), the same code the service's fit_material job is meant to call; only storing
-/// (--name) talks to the service.
+/// in the service's material library. The data are checked locally (server/jobs/fit_job), then the fit
+/// runs as a fit_material job on the service (embedded by default), which also stores it under --name.
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -11,6 +10,7 @@
 #include "cli_output.hpp"
 #include "commands.hpp"
 #include "exit_codes.hpp"
+#include "job_watch.hpp"
 #include "jobs/fit_job.hpp"
 #include "service_connection.hpp"
 
@@ -123,7 +123,6 @@ int run_fit_material_command(const std::vector<std::string>& args) {
     return report_error(command, "--plot needs an .svg file name", EXIT_BAD_INPUT);
 
   std::vector<jobs::FitDataFile> data;
-  std::vector<std::string> labels;
   for (size_t f = 0; f < parsed->positionals.size(); ++f) {
     const std::string& path = parsed->positionals[f];
     Result<std::string> bytes = read_file(path);
@@ -142,34 +141,83 @@ int run_fit_material_command(const std::vector<std::string>& args) {
       if (!number) return report_error(command, number.error(), EXIT_BAD_INPUT);
       file.thickness_mm = *number;
     }
-    labels.push_back(path);
     data.push_back(std::move(file));
   }
   Result<jobs::FitInput> input = jobs::prepare_fit(data, *parsed->get("model"));
   if (!input) return report_error(command, input.error(), EXIT_BAD_INPUT);
-  Result<jobs::FitOutcome> outcome = jobs::run_fit(*input);
-  if (!outcome) return report_error(command, outcome.error(), EXIT_BAD_INPUT);
+  // The fit runs as a service job (embedded server by default); the local checks above give bad data
+  // its one-line error before anything connects.
+  auto connection = ServiceConnection::open(connection_options(*parsed));
+  if (!connection) return report_error(command, connection.error(), EXIT_UNAVAILABLE);
+  v1::SubmitJobRequest request;
+  v1::FitMaterialJob* job = request.mutable_spec()->mutable_fit_material();
+  for (const jobs::FitDataFile& file : data) {
+    v1::MeasurementSet* set = job->add_data();
+    set->set_csv(file.csv_text);
+    set->set_test(file.test);
+    set->set_radius_mm(file.radius_mm);
+    set->set_thickness_mm(file.thickness_mm);
+  }
+  job->set_model(*parsed->get("model"));
+  const std::optional<std::string> name = parsed->get("name");
+  if (name) job->set_name(*name);
+  std::string job_id;
+  {
+    grpc::ClientContext context;
+    (*connection)->prepare(context);
+    v1::SubmitJobResponse submitted;
+    const grpc::Status status = (*connection)->stub().SubmitJob(&context, request, &submitted);
+    if (!status.ok()) {
+      std::string message = status.error_message();
+      if (status.error_code() == grpc::StatusCode::PERMISSION_DENIED && name) message = "--name " + *name + ": " + message;
+      return report_error(command, message, exit_code_for(status));
+    }
+    job_id = submitted.job().id();
+  }
+  const WatchOutcome watched = watch_job(**connection, job_id, [](const v1::JobEvent&) {});
+  if (watched.interrupted) {
+    grpc::ClientContext context;
+    (*connection)->prepare(context);
+    v1::CancelJobRequest cancel;
+    cancel.set_job_id(job_id);
+    v1::Job cancelled;
+    (*connection)->stub().CancelJob(&context, cancel, &cancelled);
+    return report_error(command, "interrupted; job " + job_id + " cancelled", EXIT_INTERRUPTED);
+  }
+  if (!watched.status.ok()) return report_error(command, watched.status.error_message(), exit_code_for(watched.status));
+  if (watched.state != v1::JOB_STATE_COMPLETED) {
+    // A fit fails on its data (exit 2, as when it ran in-process) unless the job was stopped from outside.
+    const bool stopped = watched.state == v1::JOB_STATE_CANCELLED || watched.message.rfind("time limit", 0) == 0;
+    return report_error(command, watched.message, stopped ? EXIT_JOB_FAILED : EXIT_BAD_INPUT);
+  }
+  v1::JobResult result;
+  v1::Job finished;
+  {
+    grpc::ClientContext context;
+    (*connection)->prepare(context);
+    v1::GetResultRequest result_request;
+    result_request.set_job_id(job_id);
+    const grpc::Status status = (*connection)->stub().GetResult(&context, result_request, &result);
+    if (!status.ok()) return report_error(command, status.error_message(), exit_code_for(status));
+    grpc::ClientContext job_context;
+    (*connection)->prepare(job_context);
+    v1::GetJobRequest job_request;
+    job_request.set_job_id(job_id);
+    if (!(*connection)->stub().GetJob(&job_context, job_request, &finished).ok()) finished.Clear();
+  }
+  // The report carries every number; labels and tests come from the local input (the wire has no file names).
+  Result<jobs::FitOutcome> outcome = jobs::fit_outcome_from_json(*input, result.report_json());
+  if (!outcome) return report_error(command, "job " + job_id + ": " + outcome.error(), EXIT_INTERNAL);
+  if (finished.finished_ms() > 0 && finished.started_ms() > 0)
+    outcome->time_s = 1e-3 * static_cast<double>(finished.finished_ms() - finished.started_ms());
 
   if (auto plot = parsed->get("plot")) {
     Result<bool> written = write_file_atomically(*plot, jobs::fit_plot_svg(*input, *outcome));
     if (!written) return report_error(command, written.error(), EXIT_INTERNAL);
   }
-  if (auto name = parsed->get("name")) {
+  if (name && !parsed->has("json")) {
     const FitResult& best = outcome->fits[static_cast<size_t>(jobs::best_fit_index(*outcome))];
-    ConnectionOptions connection_opts = connection_options(*parsed);
-    connection_opts.run_jobs = false;
-    auto connection = ServiceConnection::open(connection_opts);
-    if (!connection) return report_error(command, connection.error(), EXIT_UNAVAILABLE);
-    grpc::ClientContext context;
-    (*connection)->prepare(context);
-    v1::PutMaterialRequest request;
-    request.mutable_material()->set_name(*name);
-    request.mutable_material()->set_spec(material_spec(best.material));
-    request.mutable_material()->set_description(jobs::fit_provenance(*input, best, labels));
-    v1::Material stored;
-    const grpc::Status status = (*connection)->stub().PutMaterial(&context, request, &stored);
-    if (!status.ok()) return report_error(command, "--name " + *name + ": " + status.error_message(), exit_code_for(status));
-    if (!parsed->has("json")) std::printf("stored %s: %s\n", stored.name().c_str(), stored.spec().c_str());
+    std::printf("stored %s: %s\n", name->c_str(), material_spec(best.material).c_str());
   }
   if (parsed->has("json"))
     std::cout << jobs::fit_report_json(*input, *outcome) << std::endl;

@@ -1,7 +1,8 @@
 #pragma once
 /// The material-fit job without any transport: parse and check measurement files, fit one or all rubber
 /// laws, and describe the outcome (text, JSON, SVG plot, provenance for the material library).
-/// The CLI runs fits through this layer; the service's FitMaterialJob branch is meant to call the same code.
+/// The service's fit_material job runs fits through this layer; the CLI checks data with prepare_fit and
+/// reads the job's report back with fit_outcome_from_json to print and plot it.
 #include <string>
 #include <string_view>
 #include <vector>
@@ -47,6 +48,12 @@ Result<FitOutcome> run_fit(const FitInput& input);
 
 /// Index into outcome.fits of the best fit (smallest RMS relative residual).
 int best_fit_index(const FitOutcome& outcome);
+
+/// Reads a report written by fit_report_json back into fits, for a client that ran the fit as a service
+/// job: `input` is the same job's input (checked locally), which gives each fit its model and each set
+/// its label and test. Null numbers (non-finite standard errors) read back as infinity. Fails on a
+/// report that does not match the input.
+Result<FitOutcome> fit_outcome_from_json(const FitInput& input, const std::string& report_json);
 
 /// One fit as a JSON object: model, spec, params (by SPEC name), std_errors, rms_residual, max_residual,
 /// residual_unit, rms_relative_residual, max_relative_residual, points, converged, regimes, sets, message.

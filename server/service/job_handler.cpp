@@ -11,6 +11,7 @@
 #include <random>
 
 #include "jobs/design_job.hpp"
+#include "jobs/fit_job.hpp"
 #include "jobs/simulate_job.hpp"
 #include "mesh/mesh_io.hpp"
 #include "store/mesh_blob.hpp"
@@ -23,6 +24,7 @@ using store::JobState;
 
 constexpr const char* KIND_SIMULATE = "simulate";
 constexpr const char* KIND_DESIGN = "design";
+constexpr const char* KIND_FIT_MATERIAL = "fit_material";
 constexpr int MAX_PAGE_SIZE = 1000;
 constexpr int DEFAULT_PAGE_SIZE = 100;
 constexpr double SHAPE_CHECKPOINT_INTERVAL_S = 1.0;  // stored shapes are big: at most one a second per job
@@ -41,7 +43,7 @@ v1::JobState to_proto(JobState state) {
 v1::JobKind kind_to_proto(const std::string& kind) {
   if (kind == KIND_SIMULATE) return v1::JOB_KIND_SIMULATE;
   if (kind == KIND_DESIGN) return v1::JOB_KIND_DESIGN;
-  if (kind == "fit_material") return v1::JOB_KIND_FIT_MATERIAL;
+  if (kind == KIND_FIT_MATERIAL) return v1::JOB_KIND_FIT_MATERIAL;
   return v1::JOB_KIND_UNSPECIFIED;
 }
 
@@ -183,6 +185,46 @@ static LoadedDesign load_design(const v1::DesignJob& job, const std::string& ten
   return loaded;
 }
 
+/// The proto measurement sets as the job layer's files; labels are "data[i]" (the wire carries no file names).
+static std::vector<jobs::FitDataFile> fit_files(const v1::FitMaterialJob& job) {
+  std::vector<jobs::FitDataFile> files;
+  files.reserve(static_cast<size_t>(job.data_size()));
+  for (int i = 0; i < job.data_size(); ++i) {
+    const v1::MeasurementSet& set = job.data(i);
+    jobs::FitDataFile file;
+    file.label = "data[" + std::to_string(i) + "]";
+    file.csv_text = set.csv();
+    file.test = set.test();
+    file.radius_mm = set.radius_mm();
+    file.thickness_mm = set.thickness_mm();
+    files.push_back(std::move(file));
+  }
+  return files;
+}
+
+/// Checks a fit job (data, model, the name it stores under). Errors carry their status code.
+static ServiceStatus check_fit(const v1::FitMaterialJob& job, std::optional<jobs::FitInput>* input) {
+  if (job.data_size() == 0) return ServiceStatus::error(StatusCode::InvalidArgument, "fit_material.data is empty");
+  if (!job.name().empty()) {
+    const std::string problem = material_name_problem(job.name());
+    if (!problem.empty()) return ServiceStatus::error(StatusCode::InvalidArgument, "fit_material.name: " + problem);
+    const std::vector<std::string> presets = preset_names();
+    if (std::find(presets.begin(), presets.end(), job.name()) != presets.end())
+      return ServiceStatus::error(StatusCode::PermissionDenied,
+                                  "fit_material.name: '" + job.name() + "' is a preset and cannot be overwritten");
+  }
+  Result<jobs::FitInput> prepared = jobs::prepare_fit(fit_files(job), job.model());
+  if (!prepared) return ServiceStatus::error(StatusCode::InvalidArgument, "fit_material: " + prepared.error());
+  *input = std::move(*prepared);
+  return ServiceStatus::success();
+}
+
+static std::string fit_summary(const v1::FitMaterialJob& job, const jobs::FitInput& input) {
+  std::string summary = "fit_material " + job.model() + " to " + std::to_string(input.sets.size()) + " data set(s)";
+  if (!job.name().empty()) summary += ", stored as " + job.name();
+  return summary;
+}
+
 static std::string design_summary(const jobs::DesignInput& input) {
   std::string summary = "design " + std::to_string(input.target.mesh.vertex_count()) + " vertices, " +
                         (input.material.name.empty() ? material_spec(input.material) : input.material.name) + ", " +
@@ -277,8 +319,7 @@ ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobReques
   switch (spec.kind_case()) {
     case v1::JobSpec::kSimulate: break;
     case v1::JobSpec::kDesign: break;
-    case v1::JobSpec::kFitMaterial:
-      return ServiceStatus::error(StatusCode::Unimplemented, "material-fit jobs are not available yet");
+    case v1::JobSpec::kFitMaterial: break;
     case v1::JobSpec::KIND_NOT_SET:
       return ServiceStatus::error(StatusCode::InvalidArgument, "spec names no job (simulate, design or fit_material)");
   }
@@ -302,6 +343,12 @@ ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobReques
       stored.mutable_design()->mutable_material()->set_spec(material_spec(loaded.input->material));
     kind = KIND_DESIGN;
     summary = design_summary(*loaded.input);
+  } else if (spec.kind_case() == v1::JobSpec::kFitMaterial) {
+    std::optional<jobs::FitInput> input;
+    const ServiceStatus checked = check_fit(spec.fit_material(), &input);
+    if (!checked.ok()) return checked;
+    kind = KIND_FIT_MATERIAL;
+    summary = fit_summary(spec.fit_material(), *input);
   } else {
     LoadedSimulate loaded = load_simulate(spec.simulate(), caller.tenant, m_options.max_mesh_vertices, m_materials);
     if (!loaded.input) return ServiceStatus::error(loaded.code, loaded.error);
@@ -493,6 +540,14 @@ ServiceStatus JobHandler::result(const Caller& caller, const v1::GetResultReques
     return ServiceStatus::error(StatusCode::InvalidArgument, "meshes can be returned as OBJ, STL or PLY only");
   const auto stored = m_jobs.result(record->row_id);
   if (!stored) return ServiceStatus::error(StatusCode::Internal, "job " + record->job_id + " has lost its result");
+  if (record->kind == KIND_FIT_MATERIAL) {
+    // A fit has no meshes: the report is the whole result.
+    reply->set_job_id(record->job_id);
+    reply->set_kind(kind_to_proto(record->kind));
+    reply->set_converged(stored->converged);
+    reply->set_report_json(stored->report_json);
+    return ServiceStatus::success();
+  }
   const Result<TriMesh> rest = store::decode_mesh_blob(stored->rest_mesh);
   const Result<TriMesh> inflated = store::decode_mesh_blob(stored->inflated_mesh);
   if (!rest || !inflated) return ServiceStatus::error(StatusCode::Internal, "stored meshes are unreadable");
@@ -566,6 +621,8 @@ void JobHandler::run_job(std::int64_t row_id) {
       run_simulate_job(*record, spec, *active);
     } else if (spec_ok && spec.kind_case() == v1::JobSpec::kDesign) {
       run_design_job(*record, spec, *active);
+    } else if (spec_ok && spec.kind_case() == v1::JobSpec::kFitMaterial) {
+      run_fit_job(*record, spec, *active);
     } else {
       const std::string error = spec_ok ? "this server cannot run this kind of job" : "the stored job spec is unreadable";
       m_jobs.mark_failed(row_id, error);
@@ -714,6 +771,49 @@ void JobHandler::run_design_job(const store::JobRecord& record, const v1::JobSpe
   log("job " + record.job_id + " " + message);
   v1::JobEvent done = state_event(record.job_id, v1::JOB_STATE_COMPLETED, message);
   done.set_converged(outcome.result.converged);
+  close_watchers(record.job_id, std::move(done));
+}
+
+void JobHandler::run_fit_job(const store::JobRecord& record, const v1::JobSpec& spec, ActiveJob& active) {
+  const auto fail_job = [&](const std::string& error) {
+    m_jobs.mark_failed(record.row_id, error);
+    log("job " + record.job_id + " failed: " + error);
+    close_watchers(record.job_id, state_event(record.job_id, v1::JOB_STATE_FAILED, error));
+  };
+  const v1::FitMaterialJob& job = spec.fit_material();
+  std::optional<jobs::FitInput> input;
+  if (const ServiceStatus checked = check_fit(job, &input); !checked.ok()) return fail_job(checked.message);
+  // The fit has no iteration callback: it cannot be stopped midway, only its outcome discarded.
+  Result<jobs::FitOutcome> outcome = jobs::run_fit(*input);
+  if (active.stop_reason != static_cast<int>(StopReason::None)) {
+    finish_stopped(record, active);
+    return;
+  }
+  if (!outcome) return fail_job(outcome.error());
+  const FitResult& best = outcome->fits[static_cast<size_t>(jobs::best_fit_index(*outcome))];
+  std::string stored_note;
+  if (!job.name().empty()) {
+    std::vector<std::string> labels;
+    for (int i = 0; i < job.data_size(); ++i) labels.push_back("data[" + std::to_string(i) + "]");
+    v1::PutMaterialRequest put;
+    put.mutable_material()->set_name(job.name());
+    put.mutable_material()->set_spec(material_spec(best.material));
+    put.mutable_material()->set_description(jobs::fit_provenance(*input, best, labels));
+    v1::Material stored_material;
+    const ServiceStatus status = m_materials.put(Caller{record.owner}, put, &stored_material);
+    if (!status.ok()) return fail_job("storing material '" + job.name() + "': " + status.message);
+    stored_note = ", stored as " + stored_material.name();
+  }
+  store::ResultRecord result;
+  result.converged = true;
+  for (const FitResult& fit : outcome->fits) result.converged = result.converged && fit.converged;
+  result.report_json = jobs::fit_report_json(*input, *outcome);
+  if (!m_jobs.mark_completed(record.row_id, result)) return;  // cancelled as it finished: that already published
+  const std::string message = "completed: best fit " + material_spec(best.material) + " in " +
+                              format_number(outcome->time_s) + " s" + stored_note;
+  log("job " + record.job_id + " " + message);
+  v1::JobEvent done = state_event(record.job_id, v1::JOB_STATE_COMPLETED, message);
+  done.set_converged(result.converged);
   close_watchers(record.job_id, std::move(done));
 }
 

@@ -77,6 +77,9 @@ class JobHandler {
   void run_simulate_job(const store::JobRecord& record, const balloon::v1::JobSpec& spec, ActiveJob& active);
   /// Runs a design job (jobs/design_job) to its end state and publishes it, like run_simulate_job.
   void run_design_job(const store::JobRecord& record, const balloon::v1::JobSpec& spec, ActiveJob& active);
+  /// Runs a material-fit job (jobs/fit_job): the report JSON is its result; with a name, the best fit is
+  /// stored as the owner's material (with its provenance) before the job completes.
+  void run_fit_job(const store::JobRecord& record, const balloon::v1::JobSpec& spec, ActiveJob& active);
   /// The triangles the first intermediate mesh of a job's watchers carries.
   void set_connectivity(const std::string& job_id, const Faces& faces);
   /// A progress callback that publishes a running job's events (with the intermediate mesh every K

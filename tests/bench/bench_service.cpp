@@ -1,0 +1,179 @@
+/// Service benchmark: an in-process balloon server on 127.0.0.1:0 (real TCP on loopback) with N workers,
+/// K client threads each submitting J small simulate jobs (icosphere, subdivision 2) one after the other
+/// and watching each to its end. With K > N every worker stays busy while others submit. Prints SubmitJob
+/// latency and progress-event latency (client receive time minus the server's event stamp, JobEvent.time_ms,
+/// both on this machine's wall clock, so millisecond resolution) and the watch-stream inter-arrival time.
+///
+/// Usage: bench_service [--workers N] [--clients K] [--jobs J]   (defaults 2, 6, 4)
+#include <stdlib.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <grpcpp/grpcpp.h>
+
+#include "balloon/v1/balloon.grpc.pb.h"
+#include "mesh/icosphere.hpp"
+#include "mesh/mesh_io.hpp"
+#include "rpc/grpc_server.hpp"
+
+namespace {
+
+namespace v1 = balloon::v1;
+using Clock = std::chrono::steady_clock;
+
+constexpr int WATCH_DEADLINE_S = 120;  // a stuck job ends the bench instead of hanging it
+
+double percentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const size_t index = std::min(values.size() - 1, static_cast<size_t>(q * static_cast<double>(values.size() - 1) + 0.5));
+  return values[index];
+}
+
+std::int64_t wall_ms() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+int int_flag(int argc, char** argv, const char* name, int fallback) {
+  for (int i = 1; i + 1 < argc; ++i)
+    if (std::strcmp(argv[i], name) == 0) return std::max(1, std::atoi(argv[i + 1]));
+  return fallback;
+}
+
+struct ClientStats {
+  std::vector<double> submit_ms;        ///< SubmitJob round trip (ms)
+  std::vector<double> event_latency_ms; ///< receive wall time - JobEvent.time_ms, progress events only (ms)
+  std::vector<double> interarrival_ms;  ///< time between consecutive progress events of one stream (ms)
+  int completed = 0, failed = 0, events = 0, mesh_events = 0, busy_samples = 0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int workers = int_flag(argc, argv, "--workers", 2);
+  const int clients = int_flag(argc, argv, "--clients", 6);
+  const int jobs_per_client = std::min(50, int_flag(argc, argv, "--jobs", 4));
+
+  std::string scratch = (std::filesystem::temp_directory_path() / "balloon-bench-XXXXXX").string();
+  if (mkdtemp(scratch.data()) == nullptr) {
+    std::perror("mkdtemp");
+    return 1;
+  }
+  balloon::rpc::ServerConfig config;
+  config.listen_address = "127.0.0.1:0";
+  config.service.db_path = scratch + "/bench.db";
+  config.service.workers = workers;
+  auto server = balloon::rpc::GrpcServer::start(config);
+  if (!server) {
+    std::fprintf(stderr, "bench_service: %s\n", server.error().c_str());
+    return 1;
+  }
+  const std::string address = "127.0.0.1:" + std::to_string((*server)->port());
+  std::printf("server %s, %d workers, %d clients x %d simulate jobs (icosphere sub 2, 162 vertices)\n",
+              address.c_str(), workers, clients, jobs_per_client);
+
+  const std::string obj = balloon::write_mesh_to_memory(balloon::make_icosphere(10.0, 2), "obj");
+  v1::SubmitJobRequest request;
+  v1::SimulateJob* job = request.mutable_spec()->mutable_simulate();
+  job->mutable_rest_mesh()->set_data(obj);
+  job->mutable_rest_mesh()->set_format(v1::MESH_FORMAT_OBJ);
+  job->mutable_material()->set_spec("neo-hookean:mu=0.3");
+  job->set_thickness_mm(0.5);
+  job->set_pressure_kpa(18.0);  // a pressure walk: several progress events per job
+
+  std::atomic<int> running_jobs{0};
+  std::vector<ClientStats> stats(static_cast<size_t>(clients));
+  std::vector<std::thread> threads;
+  const auto start = Clock::now();
+  for (int c = 0; c < clients; ++c) {
+    threads.emplace_back([&, c] {
+      ClientStats& mine = stats[static_cast<size_t>(c)];
+      // One channel per client, as separate processes would have.
+      grpc::ChannelArguments arguments;
+      arguments.SetInt("grpc.use_local_subchannel_pool", 1);
+      auto channel = grpc::CreateCustomChannel(address, grpc::InsecureChannelCredentials(), arguments);
+      auto stub = v1::BalloonService::NewStub(channel);
+      for (int j = 0; j < jobs_per_client; ++j) {
+        v1::SubmitJobResponse submitted;
+        grpc::ClientContext submit_context;
+        const auto before = Clock::now();
+        const grpc::Status status = stub->SubmitJob(&submit_context, request, &submitted);
+        mine.submit_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - before).count());
+        if (running_jobs.load() >= workers) ++mine.busy_samples;
+        if (!status.ok()) {
+          ++mine.failed;
+          continue;
+        }
+        grpc::ClientContext watch_context;
+        watch_context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(WATCH_DEADLINE_S));
+        v1::WatchJobRequest watch;
+        watch.set_job_id(submitted.job().id());
+        auto reader = stub->WatchJob(&watch_context, watch);
+        v1::JobEvent event;
+        bool counted_running = false;
+        Clock::time_point last_progress{};
+        v1::JobState last_state = v1::JOB_STATE_UNSPECIFIED;
+        while (reader->Read(&event)) {
+          const std::int64_t received = wall_ms();
+          ++mine.events;
+          last_state = event.state();
+          if (event.state() == v1::JOB_STATE_RUNNING && !counted_running) {
+            counted_running = true;
+            ++running_jobs;
+          }
+          if (!event.has_progress() || event.state() != v1::JOB_STATE_RUNNING || event.time_ms() == 0) continue;
+          if (event.has_mesh()) ++mine.mesh_events;
+          mine.event_latency_ms.push_back(static_cast<double>(received - event.time_ms()));
+          const auto now = Clock::now();
+          if (last_progress != Clock::time_point{})
+            mine.interarrival_ms.push_back(std::chrono::duration<double, std::milli>(now - last_progress).count());
+          last_progress = now;
+        }
+        reader->Finish();
+        if (counted_running) --running_jobs;
+        if (last_state == v1::JOB_STATE_COMPLETED)
+          ++mine.completed;
+        else
+          ++mine.failed;
+      }
+    });
+  }
+  for (std::thread& thread : threads) thread.join();
+  const double wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+  (*server)->shutdown(2.0);
+  std::error_code ignored;
+  std::filesystem::remove_all(scratch, ignored);
+
+  ClientStats all;
+  for (const ClientStats& one : stats) {
+    all.submit_ms.insert(all.submit_ms.end(), one.submit_ms.begin(), one.submit_ms.end());
+    all.event_latency_ms.insert(all.event_latency_ms.end(), one.event_latency_ms.begin(), one.event_latency_ms.end());
+    all.interarrival_ms.insert(all.interarrival_ms.end(), one.interarrival_ms.begin(), one.interarrival_ms.end());
+    all.completed += one.completed;
+    all.failed += one.failed;
+    all.events += one.events;
+    all.mesh_events += one.mesh_events;
+    all.busy_samples += one.busy_samples;
+  }
+  std::printf("jobs: %d completed, %d failed, in %.2f s (%.2f jobs/s)\n", all.completed, all.failed, wall_s,
+              all.completed / wall_s);
+  std::printf("SubmitJob latency (ms): p50 %.2f  p99 %.2f  max %.2f  over %zu calls (%d made with every worker busy)\n",
+              percentile(all.submit_ms, 0.5), percentile(all.submit_ms, 0.99), percentile(all.submit_ms, 1.0),
+              all.submit_ms.size(), all.busy_samples);
+  std::printf("progress-event latency, server stamp -> client (ms, 1 ms resolution): p50 %.0f  p99 %.0f  max %.0f  over %zu events (%d with meshes)\n",
+              percentile(all.event_latency_ms, 0.5), percentile(all.event_latency_ms, 0.99),
+              percentile(all.event_latency_ms, 1.0), all.event_latency_ms.size(), all.mesh_events);
+  std::printf("watch-stream inter-arrival of progress events (ms): p50 %.2f  p99 %.2f\n",
+              percentile(all.interarrival_ms, 0.5), percentile(all.interarrival_ms, 0.99));
+  return all.failed == 0 ? 0 : 1;
+}
