@@ -176,12 +176,7 @@ int run_fit_material_command(const std::vector<std::string>& args) {
   }
   const WatchOutcome watched = watch_job(**connection, job_id, [](const v1::JobEvent&) {});
   if (watched.interrupted) {
-    grpc::ClientContext context;
-    (*connection)->prepare(context);
-    v1::CancelJobRequest cancel;
-    cancel.set_job_id(job_id);
-    v1::Job cancelled;
-    (*connection)->stub().CancelJob(&context, cancel, &cancelled);
+    cancel_job(**connection, job_id);
     return report_error(command, "interrupted; job " + job_id + " cancelled", EXIT_INTERRUPTED);
   }
   if (!watched.status.ok()) return report_error(command, watched.status.error_message(), exit_code_for(watched.status));

@@ -16,6 +16,15 @@ extern "C" void on_interrupt(int) { g_interrupted.store(true); }
 
 }  // namespace
 
+void cancel_job(ServiceConnection& connection, const std::string& job_id) {
+  grpc::ClientContext context;
+  connection.prepare(context);
+  balloon::v1::CancelJobRequest request;
+  request.set_job_id(job_id);
+  balloon::v1::Job job;
+  connection.stub().CancelJob(&context, request, &job);
+}
+
 std::string state_name(balloon::v1::JobState state) {
   switch (state) {
     case balloon::v1::JOB_STATE_QUEUED: return "queued";

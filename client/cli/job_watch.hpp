@@ -22,6 +22,9 @@ struct WatchOutcome {
 WatchOutcome watch_job(ServiceConnection& connection, const std::string& job_id,
                        const std::function<void(const balloon::v1::JobEvent&)>& on_event);
 
+/// Asks the service to cancel `job_id` (best effort: after Ctrl-C the CLI exits either way).
+void cancel_job(ServiceConnection& connection, const std::string& job_id);
+
 /// Prints progress events on stderr: one updating line on a terminal, plain lines otherwise.
 class ProgressPrinter {
  public:

@@ -134,12 +134,7 @@ int run_simulate_command(const std::vector<std::string>& args) {
   ProgressPrinter printer(isatty(STDERR_FILENO) == 1);
   const WatchOutcome outcome = watch_job(**connection, job_id, [&](const v1::JobEvent& event) { printer(event); });
   if (outcome.interrupted) {
-    grpc::ClientContext context;
-    (*connection)->prepare(context);
-    v1::CancelJobRequest cancel;
-    cancel.set_job_id(job_id);
-    v1::Job job;
-    (*connection)->stub().CancelJob(&context, cancel, &job);
+    cancel_job(**connection, job_id);
     return report_error(COMMAND, "interrupted; job " + job_id + " cancelled", EXIT_INTERRUPTED);
   }
   if (!outcome.status.ok()) return report_error(COMMAND, outcome.status.error_message(), exit_code_for(outcome.status));
