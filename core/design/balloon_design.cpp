@@ -27,7 +27,7 @@ std::string design_method_name(DesignMethod method) {
 
 Result<DesignMethod> parse_design_method(const std::string& name) {
   if (name == "adjoint") return DesignMethod::Adjoint;
-  if (name == "alm") return fail("design method 'alm' is not available yet (use 'adjoint')");
+  if (name == "alm") return DesignMethod::AugmentedLagrangian;
   return fail("unknown design method '" + name + "' (known: adjoint, alm)");
 }
 
@@ -78,6 +78,158 @@ class AdjointDesign {
   }
 
   DesignResult run() {
+    return m_options.method == DesignMethod::AugmentedLagrangian ? run_augmented_lagrangian() : run_adjoint();
+  }
+
+ private:
+  /// The paper's method (sec. 5.2): minimise E_dist(x) - lambda^T C + mu/2 |C|^2 over rest and inflated
+  /// positions together, C = grad_x W(x; rest) - p grad V(x) the nodal force balance at the start's
+  /// pressure p; multipliers update by eq. 22 when |C| fell enough, else mu grows. The inner solve is
+  /// L-BFGS with an Armijo line search (first-order: the Hessian of the penalty needs K and the mixed
+  /// derivative products, which this avoids). At the end the rest shape is inflated properly, so the
+  /// reported errors are those of a true equilibrium.
+  DesignResult run_augmented_lagrangian() {
+    DesignResult result;
+    result.method = DesignMethod::AugmentedLagrangian;
+    result.bbox_diag_mm = m_surface.bbox_diagonal_mm();
+    result.active_terms.push_back("distance");
+    if (!m_options.nozzle_vertices.empty()) result.active_terms.push_back("nozzle");
+    Eigen::VectorXd rest = flat(m_rest_mesh.vertices);
+    m_x = flat(scaled_about_centroid(m_rest_mesh.vertices, std::cbrt(m_target_volume / rest_volume(rest))));
+    if (!initial_inflation(rest, result)) return finish(result, rest);
+    const SurfaceDistanceStats baseline = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
+    result.baseline_avg_error_mm = baseline.avg_mm;
+    result.baseline_max_error_mm = baseline.max_mm;
+    record(result, 0, baseline);
+
+    const Eigen::Index n = rest.size();
+    std::vector<bool> free(static_cast<size_t>(2 * n));
+    for (Eigen::Index c = 0; c < n; ++c) {
+      free[static_cast<size_t>(c)] = m_rest_free[static_cast<size_t>(c)];
+      free[static_cast<size_t>(n + c)] = m_solver.assembly().free_index(static_cast<int>(c)) >= 0;
+    }
+    const double pressure = m_pressure;
+    const double force_scale = m_solver.force_scale(m_x, pressure);
+    double mu = 10.0 * std::max(m_distance.value(m_x), 1e-6 * result.bbox_diag_mm) / (force_scale * force_scale);
+    Eigen::VectorXd lambda = Eigen::VectorXd::Zero(n);
+    Eigen::VectorXd z(2 * n);
+    z << rest, m_x;
+    auto constraints = [&](const Eigen::VectorXd& zz) {
+      m_model.set_rest_positions(unflatten(zz.head(n)));
+      return m_solver.residual(zz.tail(n), pressure);
+    };
+    auto lagrangian = [&](const Eigen::VectorXd& zz, Eigen::VectorXd* gradient) {
+      const Eigen::VectorXd c = constraints(zz);
+      const double value = m_distance.value(zz.tail(n)) - lambda.dot(c) + 0.5 * mu * c.squaredNorm();
+      if (gradient) {
+        const Eigen::VectorXd w = mu * c - lambda;
+        Eigen::VectorXd distance_gradient;
+        m_distance.gradient(zz.tail(n), distance_gradient);
+        gradient->resize(2 * n);
+        gradient->head(n) = rest_force_transpose(zz.head(n), zz.tail(n), w);
+        gradient->tail(n) = distance_gradient + m_solver.stiffness_times(zz.tail(n), pressure, w);
+        for (Eigen::Index c2 = 0; c2 < 2 * n; ++c2)
+          if (!free[static_cast<size_t>(c2)]) (*gradient)[c2] = 0.0;
+      }
+      return value;
+    };
+
+    int iteration = 0;
+    double constraint_norm = constraints(z).norm();
+    result.message = "iteration limit reached";
+    for (int outer = 0; outer < 50 && iteration < m_options.max_iterations * 10; ++outer) {
+      Eigen::VectorXd gradient;
+      double value = lagrangian(z, &gradient);
+      std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> memory;
+      for (int inner = 0; inner < 100; ++inner, ++iteration) {
+        if (m_options.cancel && m_options.cancel->cancelled()) result.message = "cancelled";
+        if (m_settings.deadline_s > 0 && now_s() > m_settings.deadline_s) result.message = "time limit reached";
+        if (result.message != "iteration limit reached") break;
+        Eigen::VectorXd direction = -plain_lbfgs(memory, gradient);
+        if (!(direction.dot(gradient) < 0.0)) {
+          memory.clear();
+          direction = -gradient;
+        }
+        const double largest = std::max(unflatten(direction.head(n)).rowwise().norm().maxCoeff(),
+                                        unflatten(direction.tail(n)).rowwise().norm().maxCoeff());
+        double t = std::min(1.0, 0.01 * result.bbox_diag_mm / std::max(largest, 1e-300));
+        const double slope = direction.dot(gradient);
+        bool accepted = false;
+        Eigen::VectorXd trial_gradient;
+        for (int k = 0; k < 20 && !accepted; ++k, t *= 0.5) {
+          const Eigen::VectorXd trial = z + t * direction;
+          const double trial_value = lagrangian(trial, nullptr);
+          if (std::isfinite(trial_value) && trial_value <= value + 1e-4 * t * slope) {
+            lagrangian(trial, &trial_gradient);
+            memory.emplace_back(trial - z, trial_gradient - gradient);
+            if (memory.back().first.dot(memory.back().second) <= 0.0) memory.pop_back();
+            if (memory.size() > 30) memory.pop_front();
+            z = trial;
+            value = trial_value;
+            gradient = trial_gradient;
+            accepted = true;
+          }
+        }
+        if (!accepted) break;
+        if (iteration % 10 == 0) {
+          m_x = z.tail(n);
+          m_pressure = pressure;
+          m_last_report.residual_norm = constraints(z).norm();
+          record(result, iteration + 1, m_surface.aligned_stats(unflatten(m_x), m_target.vertices));
+        }
+        if (gradient.norm() < 1e-6 * force_scale) break;
+      }
+      if (result.message != "iteration limit reached") break;
+      const Eigen::VectorXd c = constraints(z);
+      const double new_norm = c.norm();
+      if (new_norm <= 0.25 * constraint_norm || new_norm <= 1e-6 * force_scale) {
+        lambda -= mu * c;  // eq. 22
+        constraint_norm = new_norm;
+      } else {
+        mu *= 10.0;
+      }
+      if (new_norm <= 1e-6 * force_scale && gradient.norm() < 1e-4 * force_scale) {
+        result.converged = true;
+        result.message = "converged";
+        break;
+      }
+    }
+    result.iterations = iteration;
+    // The ALM iterate only nearly balances the forces: report the true equilibrium of its rest shape.
+    rest = z.head(n);
+    Eigen::VectorXd x = z.tail(n);
+    double inflated_pressure = pressure;
+    NewtonSettings settings = m_settings;
+    settings.deadline_s = 0.0;
+    m_model.set_rest_positions(unflatten(rest));
+    m_last_report = m_solver.solve_volume(x, inflated_pressure, m_target_volume, settings);
+    m_x = x;
+    m_pressure = inflated_pressure;
+    if (!m_last_report.converged) {
+      result.converged = false;
+      result.message += "; the final rest shape did not reach equilibrium (" + m_last_report.message + ")";
+    }
+    return finish(result, rest);
+  }
+
+  static Eigen::VectorXd plain_lbfgs(const std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>>& memory,
+                                     const Eigen::VectorXd& gradient) {
+    Eigen::VectorXd q = gradient;
+    std::vector<double> alpha(memory.size());
+    for (int i = static_cast<int>(memory.size()) - 1; i >= 0; --i) {
+      const auto& [s, y] = memory[static_cast<size_t>(i)];
+      alpha[static_cast<size_t>(i)] = s.dot(q) / y.dot(s);
+      q -= alpha[static_cast<size_t>(i)] * y;
+    }
+    if (!memory.empty()) q *= memory.back().first.dot(memory.back().second) / memory.back().second.squaredNorm();
+    for (size_t i = 0; i < memory.size(); ++i) {
+      const auto& [s, y] = memory[i];
+      q += (alpha[i] - y.dot(q) / y.dot(s)) * s;
+    }
+    return q;
+  }
+
+  DesignResult run_adjoint() {
     DesignResult result;
     result.method = DesignMethod::Adjoint;
     result.bbox_diag_mm = m_surface.bbox_diagonal_mm();
@@ -322,20 +474,7 @@ class AdjointDesign {
     const double vb = v.dot(b);
     if (!(std::abs(vb) > 0.0)) return false;
     const Eigen::VectorXd lambda = a - (v.dot(a) / vb) * b;
-    gradient = Eigen::VectorXd::Zero(rest.size());
-    const Faces& faces = m_target.faces;
-    for (int f = 0; f < faces.rows(); ++f) {
-      fem::Vector9d rest_corners, x_corners, lambda_corners;
-      for (int k = 0; k < 3; ++k) {
-        rest_corners.segment<3>(3 * k) = rest.segment<3>(3 * faces(f, k));
-        x_corners.segment<3>(3 * k) = m_x.segment<3>(3 * faces(f, k));
-        lambda_corners.segment<3>(3 * k) = lambda.segment<3>(3 * faces(f, k));
-      }
-      const fem::Matrix9d mixed =
-          fem::membrane_mixed_derivative(m_options.material, m_options.thickness_mm, rest_corners, x_corners);
-      const fem::Vector9d contribution = -mixed.transpose() * lambda_corners;
-      for (int k = 0; k < 3; ++k) gradient.segment<3>(3 * faces(f, k)) += contribution.segment<3>(3 * k);
-    }
+    gradient = -rest_force_transpose(rest, m_x, lambda);
     if (m_collision->any_active()) {
       Eigen::VectorXd collision_gradient;
       m_collision->gradient(rest, collision_gradient);
@@ -351,6 +490,27 @@ class AdjointDesign {
       if (!m_rest_free[static_cast<size_t>(c)]) w[c] = 0.0;
     gradient -= (gradient.dot(w) / w.squaredNorm()) * w;
     return gradient.allFinite();
+  }
+
+  /// sum over triangles of (d grad_x W_e / d rest)^T w_e: how forces weighted by w change with the rest shape.
+  Eigen::VectorXd rest_force_transpose(const Eigen::VectorXd& rest, const Eigen::VectorXd& x,
+                                       const Eigen::VectorXd& w) const {
+    Eigen::VectorXd out = Eigen::VectorXd::Zero(rest.size());
+    const Faces& faces = m_target.faces;
+    for (int f = 0; f < faces.rows(); ++f) {
+      fem::Vector9d rest_corners, x_corners, w_corners;
+      for (int k = 0; k < 3; ++k) {
+        rest_corners.segment<3>(3 * k) = rest.segment<3>(3 * faces(f, k));
+        x_corners.segment<3>(3 * k) = x.segment<3>(3 * faces(f, k));
+        w_corners.segment<3>(3 * k) = w.segment<3>(3 * faces(f, k));
+      }
+      const fem::Vector9d contribution =
+          fem::membrane_mixed_derivative(m_options.material, m_options.thickness_mm, rest_corners, x_corners)
+              .transpose() *
+          w_corners;
+      for (int k = 0; k < 3; ++k) out.segment<3>(3 * faces(f, k)) += contribution.segment<3>(3 * k);
+    }
+    return out;
   }
 
   /// d(x, p) for a rest change `direction` at the current equilibrium, using the current factorization:

@@ -73,6 +73,12 @@ bool EquilibriumSolver::factorize_exact(const Eigen::VectorXd& x, double pressur
   return m_solver.factorize_ldlt(m_assembly.values()) == SparseSolver::Status::Ok;
 }
 
+Eigen::VectorXd EquilibriumSolver::stiffness_times(const Eigen::VectorXd& x, double pressure_mpa,
+                                                   const Eigen::VectorXd& w) {
+  m_model.assemble_hessian(x, pressure_mpa, m_assembly, false);
+  return m_assembly.extend(m_assembly.multiply(m_assembly.restrict(w)));
+}
+
 Eigen::VectorXd EquilibriumSolver::solve_with_factorization(const Eigen::VectorXd& b) const {
   return m_assembly.extend(m_solver.solve(m_assembly.restrict(b)));
 }

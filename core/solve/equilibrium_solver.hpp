@@ -57,6 +57,8 @@ class EquilibriumSolver {
   bool factorize_at(const Eigen::VectorXd& x, double pressure_mpa);
   /// Factorizes the exact Hessian at x, indefinite allowed (LL^T, else LDL^T). False if singular.
   bool factorize_exact(const Eigen::VectorXd& x, double pressure_mpa);
+  /// K(x, p) w for full 3#V vectors (fixed coordinates ignored / zero), assembling K at x.
+  Eigen::VectorXd stiffness_times(const Eigen::VectorXd& x, double pressure_mpa, const Eigen::VectorXd& w);
   /// Solves K y = b with the last factorization; b and y are full 3#V vectors (fixed entries ignored / zero).
   Eigen::VectorXd solve_with_factorization(const Eigen::VectorXd& b) const;
 
