@@ -15,6 +15,8 @@
 #include "design/self_collision.hpp"
 #include "design/surface_distance.hpp"
 #include "fem/balloon_model.hpp"
+#include "fem/membrane_element.hpp"
+#include "fem/pressure_load.hpp"
 #include "mesh/mesh_geometry.hpp"
 #include "solve/equilibrium_solver.hpp"
 #include "solve/rigid_modes.hpp"
@@ -34,6 +36,17 @@ Result<DesignMethod> parse_design_method(const std::string& name) {
 namespace {
 
 constexpr double MPA_PER_KPA = 1e-3;
+/// A start hinge flatter than this (rad) counts as coplanar: it switches the rest-bending term on.
+constexpr double COPLANAR_HINGE_RAD = 1e-3;
+/// Rest-bending stiffness relative to E_dist's k_bending: enough to fix the null space of flat regions,
+/// small enough not to pull the design away from the target.
+constexpr double REST_BENDING_WEIGHT = 1e-2;
+/// The adjoint method stops when the average surface error (what the maker sees) has not improved by
+/// STALL_IMPROVEMENT (relative) in STALL_ITERATIONS iterations, even while E_dist still creeps down.
+constexpr double STALL_IMPROVEMENT = 0.01;
+constexpr int STALL_ITERATIONS = 15;
+/// Newton steps a line-search trial may take before the step is halved instead.
+constexpr int TRIAL_NEWTON_ITERATIONS = 15;
 
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -61,6 +74,7 @@ class AdjointDesign {
         m_solver(m_model, rigid_support(m_rest_mesh)),
         m_distance(target.vertices, target.faces, options.k_length, options.k_bending),
         m_surface(target),
+        m_start_hinges(m_rest_mesh.vertices, target.faces, 0.0, REST_BENDING_WEIGHT * options.k_bending),
         m_target_volume(enclosed_volume(target.vertices, target.faces)) {
     m_settings.relative_tolerance = 1e-7;
     m_settings.max_iterations = 60;
@@ -75,6 +89,10 @@ class AdjointDesign {
     collision.stiffness = 10.0 / std::pow(mean_edge_length(m_rest_mesh), 2);
     collision.contact_distance_mm = 0.5 * mean_edge_length(m_rest_mesh);
     m_collision = std::make_unique<SelfCollision>(m_rest_mesh, collision);
+    // Coplanar rest triangles leave the membrane forces blind to normal motion of their shared
+    // vertices (a null space of the rest-shape Hessian); only then does the rest-bending term (the
+    // bending part of eq. 18 against the start) take part.
+    m_rest_bending_active = (m_start_hinges.rest_angles().array().abs() < COPLANAR_HINGE_RAD).any();
   }
 
   DesignResult run() {
@@ -82,18 +100,18 @@ class AdjointDesign {
   }
 
  private:
-  /// The paper's method (sec. 5.2): minimise E_dist(x) - lambda^T C + mu/2 |C|^2 over rest and inflated
-  /// positions together, C = grad_x W(x; rest) - p grad V(x) the nodal force balance at the start's
-  /// pressure p; multipliers update by eq. 22 when |C| fell enough, else mu grows. The inner solve is
-  /// L-BFGS with an Armijo line search (first-order: the Hessian of the penalty needs K and the mixed
-  /// derivative products, which this avoids). At the end the rest shape is inflated properly, so the
-  /// reported errors are those of a true equilibrium.
+  /// The paper's method (sec. 5.2): minimise E_dist(x) + R(rest) - lambda^T C + mu/2 |C|^2 over rest and
+  /// inflated positions together, C = grad_x W(x; rest) - p grad V(x) the nodal force balance at the
+  /// start's pressure p (R: the active regularizers). Multipliers update by eq. 22 when |C| fell to a
+  /// quarter, else mu grows tenfold. The inner solve is Gauss-Newton with Levenberg-Marquardt damping and
+  /// a backtracking line search: the Hessian is approximated by H_dist^GN + mu J^T J with J = [dC/drest,
+  /// dC/dx] = [M, K] (the term lambda^T d2C is dropped), factorized by CHOLMOD on a pattern analysed once.
+  /// At the end the rest shape is inflated properly, so the reported errors are a true equilibrium's.
   DesignResult run_augmented_lagrangian() {
     DesignResult result;
     result.method = DesignMethod::AugmentedLagrangian;
     result.bbox_diag_mm = m_surface.bbox_diagonal_mm();
-    result.active_terms.push_back("distance");
-    if (!m_options.nozzle_vertices.empty()) result.active_terms.push_back("nozzle");
+    list_common_terms(result);
     Eigen::VectorXd rest = flat(m_rest_mesh.vertices);
     m_x = flat(scaled_about_centroid(m_rest_mesh.vertices, std::cbrt(m_target_volume / rest_volume(rest))));
     if (!initial_inflation(rest, result)) return finish(result, rest);
@@ -101,6 +119,7 @@ class AdjointDesign {
     result.baseline_avg_error_mm = baseline.avg_mm;
     result.baseline_max_error_mm = baseline.max_mm;
     record(result, 0, baseline);
+    remember_if_best(rest, baseline.avg_mm);
 
     const Eigen::Index n = rest.size();
     std::vector<bool> free(static_cast<size_t>(2 * n));
@@ -110,7 +129,8 @@ class AdjointDesign {
     }
     const double pressure = m_pressure;
     const double force_scale = m_solver.force_scale(m_x, pressure);
-    double mu = 10.0 * std::max(m_distance.value(m_x), 1e-6 * result.bbox_diag_mm) / (force_scale * force_scale);
+    const double start_distance = std::max(m_distance.value(m_x), 1e-6 * result.bbox_diag_mm);
+    double mu = 10.0 * start_distance / (force_scale * force_scale);
     Eigen::VectorXd lambda = Eigen::VectorXd::Zero(n);
     Eigen::VectorXd z(2 * n);
     z << rest, m_x;
@@ -120,13 +140,17 @@ class AdjointDesign {
     };
     auto lagrangian = [&](const Eigen::VectorXd& zz, Eigen::VectorXd* gradient) {
       const Eigen::VectorXd c = constraints(zz);
-      const double value = m_distance.value(zz.tail(n)) - lambda.dot(c) + 0.5 * mu * c.squaredNorm();
+      const double value =
+          m_distance.value(zz.tail(n)) + regularizer_value(zz.head(n)) - lambda.dot(c) + 0.5 * mu * c.squaredNorm();
       if (gradient) {
         const Eigen::VectorXd w = mu * c - lambda;
         Eigen::VectorXd distance_gradient;
         m_distance.gradient(zz.tail(n), distance_gradient);
         gradient->resize(2 * n);
         gradient->head(n) = rest_force_transpose(zz.head(n), zz.tail(n), w);
+        Eigen::VectorXd rest_part = gradient->head(n);
+        add_regularizer_gradient(zz.head(n), rest_part);
+        gradient->head(n) = rest_part;
         gradient->tail(n) = distance_gradient + m_solver.stiffness_times(zz.tail(n), pressure, w);
         for (Eigen::Index c2 = 0; c2 < 2 * n; ++c2)
           if (!free[static_cast<size_t>(c2)]) (*gradient)[c2] = 0.0;
@@ -134,52 +158,73 @@ class AdjointDesign {
       return value;
     };
 
+    Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> factorization;
+    bool analysed = false;
+    double damping = 0.0;  // Levenberg-Marquardt, relative to the mean diagonal
     int iteration = 0;
     double constraint_norm = constraints(z).norm();
     result.message = "iteration limit reached";
-    for (int outer = 0; outer < 50 && iteration < m_options.max_iterations * 10; ++outer) {
+    for (int outer = 0; outer < 30 && iteration < m_options.max_iterations; ++outer) {
       Eigen::VectorXd gradient;
       double value = lagrangian(z, &gradient);
-      std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> memory;
-      for (int inner = 0; inner < 100; ++inner, ++iteration) {
+      const double inner_tolerance = 1e-3 * gradient.norm();
+      for (int inner = 0; inner < 20 && iteration < m_options.max_iterations; ++inner) {
         if (m_options.cancel && m_options.cancel->cancelled()) result.message = "cancelled";
         if (m_settings.deadline_s > 0 && now_s() > m_settings.deadline_s) result.message = "time limit reached";
         if (result.message != "iteration limit reached") break;
-        Eigen::VectorXd direction = -plain_lbfgs(memory, gradient);
-        if (!(direction.dot(gradient) < 0.0)) {
-          memory.clear();
-          direction = -gradient;
+        ++iteration;
+        Eigen::SparseMatrix<double> hessian = gauss_newton_hessian(z, pressure, mu, free);
+        const double diagonal = hessian.diagonal().mean();
+        if (damping == 0.0) damping = 1e-6;
+        Eigen::VectorXd direction;
+        for (int attempt = 0; attempt < 8; ++attempt) {
+          Eigen::SparseMatrix<double> damped = hessian;
+          for (Eigen::Index c = 0; c < damped.rows(); ++c) damped.coeffRef(c, c) += damping * diagonal;
+          if (!analysed) {
+            factorization.analyzePattern(damped);
+            analysed = true;
+          }
+          factorization.factorize(damped);
+          if (factorization.info() == Eigen::Success) {
+            direction = -factorization.solve(gradient);
+            if (direction.allFinite() && direction.dot(gradient) < 0.0) break;
+          }
+          direction.resize(0);
+          damping *= 10.0;
         }
+        if (direction.size() == 0) {
+          result.message = "the Gauss-Newton system could not be factorized";
+          break;
+        }
+        // Trust region: no vertex moves more than 2% of the target's size per step.
         const double largest = std::max(unflatten(direction.head(n)).rowwise().norm().maxCoeff(),
                                         unflatten(direction.tail(n)).rowwise().norm().maxCoeff());
-        double t = std::min(1.0, 0.01 * result.bbox_diag_mm / std::max(largest, 1e-300));
+        double t = std::min(1.0, 0.02 * result.bbox_diag_mm / std::max(largest, 1e-300));
         const double slope = direction.dot(gradient);
         bool accepted = false;
-        Eigen::VectorXd trial_gradient;
-        for (int k = 0; k < 20 && !accepted; ++k, t *= 0.5) {
+        for (int k = 0; k < 20 && !accepted; ++k) {
           const Eigen::VectorXd trial = z + t * direction;
           const double trial_value = lagrangian(trial, nullptr);
           if (std::isfinite(trial_value) && trial_value <= value + 1e-4 * t * slope) {
-            lagrangian(trial, &trial_gradient);
-            memory.emplace_back(trial - z, trial_gradient - gradient);
-            if (memory.back().first.dot(memory.back().second) <= 0.0) memory.pop_back();
-            if (memory.size() > 30) memory.pop_front();
             z = trial;
-            value = trial_value;
-            gradient = trial_gradient;
+            value = lagrangian(z, &gradient);
             accepted = true;
+          } else {
+            t *= 0.5;
           }
         }
-        if (!accepted) break;
-        if (iteration % 10 == 0) {
+        damping = accepted && t == 1.0 ? std::max(1e-9, damping * 0.3) : damping * 10.0;
+        if (accepted) {
           m_x = z.tail(n);
           m_pressure = pressure;
           m_last_report.residual_norm = constraints(z).norm();
-          record(result, iteration + 1, m_surface.aligned_stats(unflatten(m_x), m_target.vertices));
+          const SurfaceDistanceStats stats = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
+          record(result, iteration, stats);
         }
-        if (gradient.norm() < 1e-6 * force_scale) break;
+        if (!accepted || gradient.norm() <= inner_tolerance) break;
       }
       if (result.message != "iteration limit reached") break;
+      update_max_volume_term(z.head(n), start_distance, result);
       const Eigen::VectorXd c = constraints(z);
       const double new_norm = c.norm();
       if (new_norm <= 0.25 * constraint_norm || new_norm <= 1e-6 * force_scale) {
@@ -188,6 +233,7 @@ class AdjointDesign {
       } else {
         mu *= 10.0;
       }
+      lagrangian(z, &gradient);
       if (new_norm <= 1e-6 * force_scale && gradient.norm() < 1e-4 * force_scale) {
         result.converged = true;
         result.message = "converged";
@@ -212,6 +258,69 @@ class AdjointDesign {
     return finish(result, rest);
   }
 
+  /// Once a rest region has turned inside out, the maximum-volume term (paper sec. 5.2) joins the
+  /// objective, weighted so that a 1% volume change is worth 1% of the start's E_dist.
+  void update_max_volume_term(const Eigen::VectorXd& rest, double start_distance, DesignResult& result) {
+    if (m_max_volume_weight > 0.0 || inverted_hinges(rest) == 0) return;
+    m_max_volume_weight = start_distance / rest_volume(flat(m_rest_mesh.vertices));
+    result.active_terms.push_back("max_volume");
+  }
+
+  /// Gauss-Newton Hessian of the augmented Lagrangian over z = (rest, x): H_dist^GN(x) on the x block,
+  /// the rest-bending Gauss-Newton block when active, plus mu J^T J with J = [M, K]. Fixed coordinates
+  /// get zero rows and columns (the damping makes them identity).
+  Eigen::SparseMatrix<double> gauss_newton_hessian(const Eigen::VectorXd& z, double pressure, double mu,
+                                                   const std::vector<bool>& free) const {
+    const Eigen::Index n = z.size() / 2;
+    const Faces& faces = m_target.faces;
+    std::vector<Eigen::Triplet<double>> jacobian_entries;
+    jacobian_entries.reserve(static_cast<size_t>(faces.rows()) * 162);
+    for (int f = 0; f < faces.rows(); ++f) {
+      fem::Vector9d rest_corners, x_corners;
+      for (int k = 0; k < 3; ++k) {
+        rest_corners.segment<3>(3 * k) = z.segment<3>(3 * faces(f, k));
+        x_corners.segment<3>(3 * k) = z.segment<3>(n + 3 * faces(f, k));
+      }
+      const fem::Matrix9d mixed =
+          fem::membrane_mixed_derivative(m_options.material, m_options.thickness_mm, rest_corners, x_corners);
+      double energy = 0.0;
+      fem::Vector9d element_gradient;
+      fem::Matrix9d stiffness;
+      fem::membrane_energy_gradient_hessian(m_options.material, m_options.thickness_mm,
+                                            fem::make_rest_triangle(rest_corners), x_corners, energy,
+                                            element_gradient, stiffness);
+      stiffness -= pressure * fem::triangle_volume_hessian(x_corners);
+      for (int i = 0; i < 9; ++i) {
+        const Eigen::Index row = 3 * faces(f, i / 3) + i % 3;
+        if (!free[static_cast<size_t>(n + row)]) continue;
+        for (int j = 0; j < 9; ++j) {
+          const Eigen::Index column = 3 * faces(f, j / 3) + j % 3;
+          if (free[static_cast<size_t>(column)]) jacobian_entries.emplace_back(row, column, mixed(i, j));
+          if (free[static_cast<size_t>(n + column)]) jacobian_entries.emplace_back(row, n + column, stiffness(i, j));
+        }
+      }
+    }
+    Eigen::SparseMatrix<double> jacobian(n, 2 * n);
+    jacobian.setFromTriplets(jacobian_entries.begin(), jacobian_entries.end());
+    Eigen::SparseMatrix<double> hessian = mu * Eigen::SparseMatrix<double>(jacobian.transpose() * jacobian);
+    std::vector<Eigen::Triplet<double>> objective_entries;
+    m_distance.hessian_triplets(z.tail(n), objective_entries, DistanceHessian::GaussNewton, static_cast<int>(n));
+    if (m_rest_bending_active)
+      m_start_hinges.hessian_triplets(z.head(n), objective_entries, DistanceHessian::GaussNewton, 0);
+    std::vector<Eigen::Triplet<double>> kept;
+    kept.reserve(objective_entries.size());
+    for (const auto& entry : objective_entries)
+      if (free[static_cast<size_t>(entry.row())] && free[static_cast<size_t>(entry.col())]) kept.push_back(entry);
+    Eigen::SparseMatrix<double> objective(2 * n, 2 * n);
+    objective.setFromTriplets(kept.begin(), kept.end());
+    hessian += objective;
+    // Every diagonal entry exists, so the damping adds to the pattern the analysis saw.
+    Eigen::SparseMatrix<double> identity(2 * n, 2 * n);
+    identity.setIdentity();
+    hessian += 0.0 * identity;
+    return hessian;
+  }
+
   static Eigen::VectorXd plain_lbfgs(const std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>>& memory,
                                      const Eigen::VectorXd& gradient) {
     Eigen::VectorXd q = gradient;
@@ -233,8 +342,8 @@ class AdjointDesign {
     DesignResult result;
     result.method = DesignMethod::Adjoint;
     result.bbox_diag_mm = m_surface.bbox_diagonal_mm();
-    result.active_terms.push_back("distance");
-    if (!m_options.nozzle_vertices.empty()) result.active_terms.push_back("nozzle");
+    list_common_terms(result);
+    result.active_terms.push_back("fixed_rest_volume");
 
     // Start: inflate the downscaled target to the target's volume; that fixes the inflation.
     Eigen::VectorXd rest = flat(m_rest_mesh.vertices);
@@ -256,6 +365,8 @@ class AdjointDesign {
     build_preconditioner();
     std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> memory;  // (s, y) pairs for L-BFGS
     int small_decreases = 0;
+    double stall_reference = baseline.avg_mm;  // best surface error at the last real improvement (mm)
+    int stall_iteration = 0;
     result.message = "iteration limit reached";
     for (int iteration = 1; iteration <= m_options.max_iterations; ++iteration) {
       if (m_options.cancel && m_options.cancel->cancelled()) {
@@ -349,6 +460,15 @@ class AdjointDesign {
         result.message = "converged";
         break;
       }
+      if (stats.avg_mm < (1.0 - STALL_IMPROVEMENT) * stall_reference) {
+        stall_reference = stats.avg_mm;
+        stall_iteration = iteration;
+      } else if (iteration - stall_iteration >= STALL_ITERATIONS) {
+        result.converged = true;
+        result.message = "converged: the surface error improved less than " + std::to_string(static_cast<int>(std::lround(100 * STALL_IMPROVEMENT))) +
+                         "% in the last " + std::to_string(STALL_ITERATIONS) + " iterations";
+        break;
+      }
     }
     // E_dist and the surface error mostly fall together; where they part, hand back the design with
     // the smallest average surface error seen (the log still shows every iterate).
@@ -375,8 +495,28 @@ class AdjointDesign {
   static TriMesh start_shape(const TriMesh& target, const DesignOptions& options) {
     TriMesh start = target;
     const double scale = options.scale > 0 ? options.scale : std::cbrt(1.0 / options.volume_ratio);
-    start.vertices = scaled_about_centroid(target.vertices, scale);
+    if (options.initial_rest.rows() == 0) {
+      start.vertices = scaled_about_centroid(target.vertices, scale);
+      return start;
+    }
+    const double wanted_volume = scale * scale * scale * enclosed_volume(target.vertices, target.faces);
+    const double given_volume = enclosed_volume(options.initial_rest, target.faces);
+    start.vertices = scaled_about_centroid(options.initial_rest, std::cbrt(wanted_volume / given_volume));
     return start;
+  }
+
+  /// Hinges of `rest` whose dihedral angle moved more than a right angle from the start's: a region
+  /// turned inside out (mirrored through its planar rim), which inflates to nearly the same shape.
+  int inverted_hinges(const Eigen::VectorXd& rest) const {
+    const auto& edges = m_start_hinges.edges();
+    const Eigen::VectorXd& start_angles = m_start_hinges.rest_angles();
+    int count = 0;
+    for (int h = 0; h < m_start_hinges.hinge_count(); ++h) {
+      const double angle = dihedral_angle(rest.segment<3>(3 * edges(h, 0)), rest.segment<3>(3 * edges(h, 1)),
+                                          rest.segment<3>(3 * edges(h, 2)), rest.segment<3>(3 * edges(h, 3)));
+      if (std::abs(angle - start_angles[h]) > 0.5 * M_PI) ++count;
+    }
+    return count;
   }
 
   static std::vector<bool> rigid_support(const TriMesh& mesh) {
@@ -415,7 +555,11 @@ class AdjointDesign {
   /// Volume-controlled equilibrium of `rest` from (x, p); false when it does not converge.
   bool equilibrium(const Eigen::VectorXd& rest, Eigen::VectorXd& x, double& pressure) {
     m_model.set_rest_positions(unflatten(rest));
-    m_last_report = m_solver.solve_volume(x, pressure, m_target_volume, m_settings);
+    // A trial starts a first-order step from its solution; one that needs many Newton steps has entered
+    // a wrinkling region, and a shorter step is cheaper than following the slow path to the end.
+    NewtonSettings settings = m_settings;
+    settings.max_iterations = TRIAL_NEWTON_ITERATIONS;
+    m_last_report = m_solver.solve_volume(x, pressure, m_target_volume, settings);
     return m_last_report.converged;
   }
 
@@ -456,9 +600,37 @@ class AdjointDesign {
   }
 
   double objective_value(const Eigen::VectorXd& rest, const Eigen::VectorXd& x) const {
-    double value = m_distance.value(x);
+    return m_distance.value(x) + regularizer_value(rest);
+  }
+
+  /// The rest-shape terms that are active: collisions, rest bending, maximum volume.
+  double regularizer_value(const Eigen::VectorXd& rest) const {
+    double value = 0.0;
     if (m_collision->any_active()) value += m_collision->value(rest);
+    if (m_rest_bending_active) value += m_start_hinges.value(rest);
+    if (m_max_volume_weight > 0.0) value -= m_max_volume_weight * rest_volume(rest);
     return value;
+  }
+
+  /// Adds the gradient of regularizer_value to `gradient`.
+  void add_regularizer_gradient(const Eigen::VectorXd& rest, Eigen::VectorXd& gradient) const {
+    Eigen::VectorXd part;
+    if (m_collision->any_active()) {
+      m_collision->gradient(rest, part);
+      gradient += part;
+    }
+    if (m_rest_bending_active) {
+      m_start_hinges.gradient(rest, part);
+      gradient += part;
+    }
+    if (m_max_volume_weight > 0.0) gradient -= m_max_volume_weight * m_model.volume_gradient(rest);
+  }
+
+  /// Active terms every method shares (the method adds its own).
+  void list_common_terms(DesignResult& result) const {
+    result.active_terms.push_back("distance");
+    if (!m_options.nozzle_vertices.empty()) result.active_terms.push_back("nozzle");
+    if (m_rest_bending_active) result.active_terms.push_back("rest_bending");
   }
 
   /// d objective / d rest through the adjoint of the bordered equilibrium system at (m_x, m_pressure):
@@ -475,11 +647,7 @@ class AdjointDesign {
     if (!(std::abs(vb) > 0.0)) return false;
     const Eigen::VectorXd lambda = a - (v.dot(a) / vb) * b;
     gradient = -rest_force_transpose(rest, m_x, lambda);
-    if (m_collision->any_active()) {
-      Eigen::VectorXd collision_gradient;
-      m_collision->gradient(rest, collision_gradient);
-      gradient += collision_gradient;
-    }
+    add_regularizer_gradient(rest, gradient);
     for (int c = 0; c < gradient.size(); ++c)
       if (!m_rest_free[static_cast<size_t>(c)]) gradient[c] = 0.0;
     // The rest volume stays at target volume / volume ratio: with the inflated volume fixed, a uniform
@@ -637,6 +805,9 @@ class AdjointDesign {
   std::unique_ptr<SelfCollision> m_collision;
   std::unique_ptr<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>>> m_preconditioner;
   bool m_collision_seen = false;
+  DistanceEnergy m_start_hinges;  ///< the start's hinge angles; with k_length 0 it is the rest-bending term
+  bool m_rest_bending_active = false;
+  double m_max_volume_weight = 0.0;  ///< alm: weight of -V(rest) once a region turned inside out (mm^-2)
   double m_target_volume;
   std::vector<bool> m_rest_free;
   NewtonSettings m_settings;
@@ -658,6 +829,12 @@ std::string options_problem(const TriMesh& target, const DesignOptions& options)
     return "volume ratio must be a number above 1";
   }
   if (!(enclosed_volume(target.vertices, target.faces) > 0.0)) return "the target encloses no positive volume";
+  if (options.initial_rest.rows() != 0) {
+    if (options.initial_rest.rows() != target.vertex_count() || !options.initial_rest.allFinite())
+      return "the initial rest shape must have one finite position per target vertex";
+    if (!(enclosed_volume(options.initial_rest, target.faces) > 0.0))
+      return "the initial rest shape encloses no positive volume";
+  }
   for (int v : options.nozzle_vertices)
     if (v < 0 || v >= target.vertex_count()) return "nozzle vertex " + std::to_string(v) + " does not exist";
   return "";

@@ -24,6 +24,10 @@ struct DesignOptions {
   /// start to the target's volume (paper sec. 5.2, "Inflation Pressure").
   double volume_ratio = 8.0;            ///< target volume / rest volume of the start
   double scale = 0.0;                   ///< linear scale of the start (0 = use volume_ratio)
+  /// Optional start rest shape (#V x 3, mm, the target's connectivity) instead of the downscaled target,
+  /// e.g. a perturbed one for the stability test. It is rescaled about its centroid to the rest volume
+  /// that `scale` or `volume_ratio` asks for.
+  Positions initial_rest;
   DesignMethod method = DesignMethod::Adjoint;
   std::vector<int> nozzle_vertices;     ///< rest vertices held at their start positions (empty = no nozzle)
   double max_time_s = 0.0;              ///< wall-time budget (s); 0 = none
@@ -59,7 +63,11 @@ struct DesignResult {
   double baseline_avg_error_mm = 0.0, baseline_max_error_mm = 0.0;  ///< the start (downscaled target) inflated
   double distance_energy = 0.0;        ///< E_dist at the end (mm)
   double residual_norm = 0.0;          ///< force residual of the inflated shape (N)
-  std::vector<std::string> active_terms;  ///< e.g. "distance", "max_volume", "rest_bending", "collision", "nozzle"
+  /// The objective's terms and constraints that took part: "distance" always; "fixed_rest_volume"
+  /// (adjoint: the rest volume is held at target volume / ratio); "max_volume" (alm, once a rest region
+  /// has turned inside out); "rest_bending" (the start has coplanar hinges); "collision" (rest vertices
+  /// came within the contact distance); "nozzle" (nozzle vertices held).
+  std::vector<std::string> active_terms;
   std::vector<ConvergenceSample> log;
 };
 

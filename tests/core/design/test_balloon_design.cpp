@@ -2,10 +2,14 @@
 // design from that target, and the designed balloon's inflation must match it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <random>
 
 #include "design/balloon_design.hpp"
 #include "mesh/icosphere.hpp"
+#include "mesh/mesh_io.hpp"
 #include "solve/inflation.hpp"
 
 namespace balloon {
@@ -41,30 +45,156 @@ TEST(BalloonDesign, RecoversTheBalloonOfAnInflatedEllipsoid) {
               design.time_s, design.avg_error_mm, design.baseline_avg_error_mm, design.message.c_str());
 }
 
-TEST(BalloonDesign, AugmentedLagrangianImprovesOnTheStartAndEndsInEquilibrium) {
-  TriMesh rest = make_icosphere(20.0, 2);  // 162 vertices
+/// A target that has an exact answer: a 162-vertex ellipsoid (semi-axes 32, 20, 20 mm) inflated six-fold.
+TriMesh inflated_small_ellipsoid() {
+  TriMesh rest = make_icosphere(20.0, 2);
   for (int v = 0; v < rest.vertex_count(); ++v) rest.vertices(v, 0) *= 1.6;
   InflationOptions inflation;
   inflation.material = *parse_material_spec("silicone");
   inflation.volume_ratio = 6.0;
   const InflationResult inflated = inflate(rest, inflation);
-  ASSERT_TRUE(inflated.converged) << inflated.message;
+  EXPECT_TRUE(inflated.converged) << inflated.message;
   TriMesh target = rest;
   target.vertices = inflated.deformed;
+  return target;
+}
 
+TEST(BalloonDesign, AugmentedLagrangianRecoversTheBalloonAndEndsInEquilibrium) {
+  const TriMesh target = inflated_small_ellipsoid();
   DesignOptions options;
-  options.material = inflation.material;
+  options.material = *parse_material_spec("silicone");
   options.volume_ratio = 6.0;
   options.method = DesignMethod::AugmentedLagrangian;
-  options.max_time_s = 8;
+  options.max_time_s = 30;
   const DesignResult design = design_balloon(target, options);
   ASSERT_FALSE(design.log.empty()) << design.message;
   EXPECT_EQ(design.method, DesignMethod::AugmentedLagrangian);
-  EXPECT_LT(design.avg_error_mm, 0.9 * design.baseline_avg_error_mm) << design.message;
+  EXPECT_TRUE(design.converged) << design.message;
+  EXPECT_LT(design.avg_error_rel, 1e-3) << design.message;
   // Reported errors are those of a true equilibrium of the designed rest shape.
   EXPECT_LT(design.residual_norm, 1e-6 * design.pressure_kpa * 1e-3 * 4e4) << design.message;
   std::printf("alm ellipsoid: %d iterations, %.2f s, avg error %.3g mm (baseline %.3g mm), %s\n", design.iterations,
               design.time_s, design.avg_error_mm, design.baseline_avg_error_mm, design.message.c_str());
+}
+
+/// Mean distance between corresponding rows (mm).
+double mean_distance(const Positions& a, const Positions& b) { return (a - b).rowwise().norm().mean(); }
+
+TEST(BalloonDesign, APerturbedStartEndsAtTheSameInflatedShape) {
+  // The paper's stability test (sec. 7): restart from the optimized rest shape moved by a smooth random
+  // field whose mean displacement is 2% of the bounding-box diagonal. The design must again inflate to
+  // the target, within 1e-3 of the diagonal of the unperturbed design's inflated shape.
+  const TriMesh target = inflated_small_ellipsoid();
+  DesignOptions options;
+  options.material = *parse_material_spec("silicone");
+  options.volume_ratio = 6.0;
+  options.max_time_s = 60;
+  const DesignResult reference = design_balloon(target, options);
+  ASSERT_TRUE(reference.converged) << reference.message;
+
+  const Positions& start = reference.rest.vertices;
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  Positions field = Positions::Zero(start.rows(), 3);
+  const double frequency = 2.0 * M_PI / (0.25 * reference.bbox_diag_mm);  // a few bumps across the shape
+  for (int wave = 0; wave < 4; ++wave) {
+    const Eigen::Vector3d direction = Eigen::Vector3d(uniform(random), uniform(random), uniform(random)).normalized();
+    const Eigen::Vector3d amplitude(uniform(random), uniform(random), uniform(random));
+    const double phase = M_PI * uniform(random);
+    for (int v = 0; v < start.rows(); ++v)
+      field.row(v) += std::sin(frequency * start.row(v).dot(direction) + phase) * amplitude.transpose();
+  }
+  const double displacement = 0.02 * reference.bbox_diag_mm;
+  field *= displacement / field.rowwise().norm().mean();
+  options.initial_rest = start + field;
+  const DesignResult perturbed = design_balloon(target, options);
+  ASSERT_TRUE(perturbed.converged) << perturbed.message;
+  EXPECT_LT(perturbed.avg_error_rel, 1e-3) << perturbed.message;
+  const double inflated_change = mean_distance(perturbed.inflated, reference.inflated) / reference.bbox_diag_mm;
+  EXPECT_LT(inflated_change, 1e-3);
+  // Inflation irons out rest-shape bumps (the start inflates to within a fraction of the perturbation), so
+  // the rest shape is only weakly determined along them; it is reported, not asserted.
+  const double rest_change = mean_distance(perturbed.rest.vertices, reference.rest.vertices) / reference.bbox_diag_mm;
+  std::printf("stability: start moved %.3g of the diagonal; inflated shapes end %.3g apart, rest shapes %.3g "
+              "(%d and %d iterations)\n", displacement / reference.bbox_diag_mm, inflated_change, rest_change,
+              reference.iterations, perturbed.iterations);
+}
+
+TEST(BalloonDesign, TheSameInputGivesTheSameOutput) {
+  const TriMesh target = inflated_small_ellipsoid();
+  for (DesignMethod method : {DesignMethod::Adjoint, DesignMethod::AugmentedLagrangian}) {
+    DesignOptions options;
+    options.material = *parse_material_spec("silicone");
+    options.volume_ratio = 6.0;
+    options.method = method;
+    options.max_iterations = 10;  // no time limit: the budget, not the clock, ends both runs
+    const DesignResult first = design_balloon(target, options);
+    const DesignResult second = design_balloon(target, options);
+    ASSERT_EQ(first.log.size(), second.log.size()) << design_method_name(method);
+    EXPECT_EQ((first.rest.vertices - second.rest.vertices).cwiseAbs().maxCoeff(), 0.0) << design_method_name(method);
+    EXPECT_EQ((first.inflated - second.inflated).cwiseAbs().maxCoeff(), 0.0) << design_method_name(method);
+    EXPECT_EQ(first.avg_error_mm, second.avg_error_mm) << design_method_name(method);
+    EXPECT_EQ(first.iterations, second.iterations) << design_method_name(method);
+  }
+}
+
+TEST(BalloonDesign, OnlyTheTermsTheSceneNeedsAreActive) {
+  const TriMesh ellipsoid = inflated_small_ellipsoid();
+  DesignOptions options;
+  options.material = *parse_material_spec("silicone");
+  options.volume_ratio = 6.0;
+  options.max_iterations = 3;
+  const DesignResult smooth = design_balloon(ellipsoid, options);
+  EXPECT_EQ(smooth.active_terms, (std::vector<std::string>{"distance", "fixed_rest_volume"}));
+
+  // A box with flat, coplanar faces: the rest-bending term must join; a nozzle adds its own.
+  Result<TriMesh> box = read_mesh(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/cube_866.off");
+  ASSERT_TRUE(box) << box.error();
+  options.nozzle_vertices = {0};
+  options.volume_ratio = 8.0;
+  const DesignResult flat = design_balloon(*box, options);
+  ASSERT_FALSE(flat.log.empty()) << flat.message;
+  const auto has = [&](const std::string& term) {
+    return std::find(flat.active_terms.begin(), flat.active_terms.end(), term) != flat.active_terms.end();
+  };
+  EXPECT_TRUE(has("rest_bending"));
+  EXPECT_TRUE(has("nozzle"));
+  EXPECT_FALSE(has("max_volume"));
+  EXPECT_LE(flat.avg_error_mm, flat.baseline_avg_error_mm) << flat.message;
+}
+
+TEST(BalloonDesign, StiffThinAndHighRatioCasesConvergeOrSayWhy) {
+  // Numerical stability on extreme scenes: a strongly stiffening rubber, a 0.05 mm membrane, and latex
+  // blown up 125-fold. Each must end with finite shapes and either converge having improved on the start,
+  // or stop with a reason; never NaN, never a silent failure.
+  const TriMesh target = inflated_small_ellipsoid();
+  struct Scene {
+    const char* name;
+    const char* material;
+    double thickness_mm;
+    double volume_ratio;
+  };
+  for (const Scene& scene : {Scene{"stiff", "hart-smith:G=0.13,k1=0.01,k2=1.0", 0.5, 8.0},
+                             Scene{"thin", "silicone", 0.05, 8.0}, Scene{"latex x125", "latex", 0.5, 125.0}}) {
+    DesignOptions options;
+    options.material = *parse_material_spec(scene.material);
+    options.thickness_mm = scene.thickness_mm;
+    options.volume_ratio = scene.volume_ratio;
+    options.max_time_s = 20;
+    const DesignResult design = design_balloon(target, options);
+    ASSERT_FALSE(design.log.empty()) << scene.name << ": " << design.message;
+    EXPECT_TRUE(design.rest.vertices.allFinite()) << scene.name;
+    EXPECT_TRUE(design.inflated.allFinite()) << scene.name;
+    EXPECT_TRUE(std::isfinite(design.avg_error_mm) && std::isfinite(design.residual_norm)) << scene.name;
+    if (design.converged) {
+      EXPECT_LT(design.avg_error_mm, 0.5 * design.baseline_avg_error_mm) << scene.name << ": " << design.message;
+    } else {
+      EXPECT_FALSE(design.message.empty()) << scene.name;
+    }
+    std::printf("%s: %s after %d iterations, %.1f s, avg error %.3g mm (baseline %.3g mm), residual %.2g N\n",
+                scene.name, design.message.c_str(), design.iterations, design.time_s, design.avg_error_mm,
+                design.baseline_avg_error_mm, design.residual_norm);
+  }
 }
 
 TEST(BalloonDesign, BadOptionsAreReportedNotThrown) {
