@@ -46,7 +46,7 @@ constexpr double REST_BENDING_WEIGHT = 1e-2;
 constexpr double STALL_IMPROVEMENT = 0.01;
 constexpr int STALL_ITERATIONS = 15;
 /// Newton steps a line-search trial may take before the step is halved instead.
-constexpr int TRIAL_NEWTON_ITERATIONS = 15;
+constexpr int TRIAL_NEWTON_ITERATIONS = 10;
 
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -350,11 +350,13 @@ class AdjointDesign {
     m_x = flat(scaled_about_centroid(m_rest_mesh.vertices, std::cbrt(m_target_volume / rest_volume(rest))));
     m_pressure = 0.0;
     if (!initial_inflation(rest, result)) return finish(result, rest);
+    debug_time("initial inflation");
     const SurfaceDistanceStats baseline = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
     result.baseline_avg_error_mm = baseline.avg_mm;
     result.baseline_max_error_mm = baseline.max_mm;
     record(result, 0, baseline);
     remember_if_best(rest, baseline.avg_mm);
+    debug_time("baseline error");
     Eigen::VectorXd gradient;
     double objective = objective_value(rest, m_x);
     if (!objective_gradient(rest, gradient)) {
@@ -363,10 +365,13 @@ class AdjointDesign {
     }
     const double initial_objective = objective;
     build_preconditioner();
+    debug_time("first gradient and preconditioner");
     std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> memory;  // (s, y) pairs for L-BFGS
     int small_decreases = 0;
     double stall_reference = baseline.avg_mm;  // best surface error at the last real improvement (mm)
     int stall_iteration = 0;
+    const double max_radius = 0.02 * result.bbox_diag_mm;  // mm
+    double radius = max_radius;
     result.message = "iteration limit reached";
     for (int iteration = 1; iteration <= m_options.max_iterations; ++iteration) {
       if (m_options.cancel && m_options.cancel->cancelled()) {
@@ -384,10 +389,12 @@ class AdjointDesign {
         memory.clear();
         direction = -gradient;
       }
-      // Trust region on the rest shape: no vertex moves more than 2% of the target's size per step.
+      // Trust region on the rest shape: no vertex moves more than `radius` (at most 2% of the target's
+      // size) per step. The radius shrinks to the last step that needed halving and grows back after
+      // full steps, so a wrinkling region costs one failed equilibrium, not one per iteration.
       const double largest = unflatten(direction).rowwise().norm().maxCoeff();
-      const double limit = 0.02 * result.bbox_diag_mm;
-      double t = largest > limit ? limit / largest : 1.0;
+      double t = largest > radius ? radius / largest : 1.0;
+      const double first_t = t;
       if (memory.empty()) t = std::min(t, 0.002 * result.bbox_diag_mm / std::max(largest, 1e-300));
       const double slope = direction.dot(gradient);
       // First-order response of the equilibrium to the rest step, from the factorization the gradient
@@ -404,8 +411,8 @@ class AdjointDesign {
         trial_pressure = m_pressure + t * pressure_response;
         const bool balanced = equilibrium(trial_rest, trial_x, trial_pressure);
         if (std::getenv("BALLOON_DEBUG_DESIGN"))
-          std::fprintf(stderr, "  it %d trial %d t=%.3g newton %d %s\n", iteration, k, t, m_last_report.iterations,
-                       m_last_report.message.c_str());
+          std::fprintf(stderr, "  it %d trial %d t=%.3g newton %d %s (%.2f s)\n", iteration, k, t,
+                       m_last_report.iterations, m_last_report.message.c_str(), now_s() - m_start);
         if (!balanced) {
           if (stopped()) break;
           continue;
@@ -429,6 +436,7 @@ class AdjointDesign {
         result.message = "converged: no further decrease along the steepest descent";
         break;
       }
+      radius = t < first_t ? t * largest : std::min(max_radius, 2.0 * radius);
       const Eigen::VectorXd step = trial_rest - rest;
       rest = trial_rest;
       m_x = trial_x;
@@ -443,6 +451,7 @@ class AdjointDesign {
         result.message = "the adjoint system could not be factorized";
         break;
       }
+      debug_time("gradient");
       const Eigen::VectorXd change = new_gradient - gradient;
       if (step.dot(change) > 1e-12 * step.norm() * change.norm()) {
         memory.emplace_back(step, change);
@@ -453,6 +462,7 @@ class AdjointDesign {
       record(result, iteration, stats);
       remember_if_best(rest, stats.avg_mm);
       result.iterations = iteration;
+      debug_time("surface error");
       const double relative_decrease = -t * slope / std::max(initial_objective, 1e-300);
       small_decreases = relative_decrease < 1e-7 ? small_decreases + 1 : 0;
       if (small_decreases >= 3 || objective <= 1e-14 * initial_objective) {
@@ -484,6 +494,11 @@ class AdjointDesign {
   }
 
  private:
+  /// With BALLOON_DEBUG_DESIGN set, prints the time since the start after `what` (stderr).
+  void debug_time(const char* what) const {
+    if (std::getenv("BALLOON_DEBUG_DESIGN")) std::fprintf(stderr, "  %s done at %.2f s\n", what, now_s() - m_start);
+  }
+
   void remember_if_best(const Eigen::VectorXd& rest, double avg_error) {
     if (avg_error >= m_best_error) return;
     m_best_error = avg_error;

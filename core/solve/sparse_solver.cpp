@@ -1,5 +1,7 @@
 #include "solve/sparse_solver.hpp"
 
+#include "solve/linear_algebra_threads.hpp"
+
 #include <cholmod.h>
 
 #include <cmath>
@@ -37,7 +39,7 @@ struct SparseSolver::Internals {
   }
 };
 
-SparseSolver::SparseSolver() : m(std::make_unique<Internals>()) {}
+SparseSolver::SparseSolver() : m(std::make_unique<Internals>()) { use_one_linear_algebra_thread(); }
 SparseSolver::~SparseSolver() = default;
 
 void SparseSolver::set_pattern(int n, const std::vector<int>& column_starts, const std::vector<int>& row_indices) {

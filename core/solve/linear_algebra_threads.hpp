@@ -1,0 +1,11 @@
+#pragma once
+/// One thread for the BLAS and OpenMP code under CHOLMOD. Our systems (up to ~1e5 unknowns) gain
+/// nothing from threaded BLAS, whose spin-waiting threads cost up to a quarter of the run time on a
+/// loaded 2-core machine; the service gets its parallelism from running jobs on several workers.
+namespace balloon {
+
+/// Limits OpenBLAS (process-wide) and OpenMP (for the calling thread) to one thread, unless the user
+/// set OPENBLAS_NUM_THREADS or OMP_NUM_THREADS. Cheap to call again; call it on every solving thread.
+void use_one_linear_algebra_thread();
+
+}  // namespace balloon
