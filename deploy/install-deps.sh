@@ -16,7 +16,17 @@ PACKAGES=(
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler libsqlite3-dev libcpp-httplib-dev
   # cross-language client test
   python3-grpcio python3-protobuf
+  # browser test of the web page (tests/web): headless Chromium driven by playwright-core
+  chromium
 )
+
+# The web page's build (client/web) and its browser test need node and npm. A machine that already has
+# node (e.g. a newer one than Debian's) keeps it; only a machine without node gets Debian's nodejs and npm.
+if ! command -v node >/dev/null 2>&1; then
+  PACKAGES+=(nodejs npm)
+elif ! command -v npm >/dev/null 2>&1; then
+  echo "install-deps: node is installed but npm is not; install npm for the web page (client/web)" >&2
+fi
 
 missing=()
 for pkg in "${PACKAGES[@]}"; do

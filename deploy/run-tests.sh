@@ -6,3 +6,16 @@ BUILD_DIR=${BUILD_DIR:-build}
 cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build "$BUILD_DIR" -j"$(nproc)"
 ctest --test-dir "$BUILD_DIR" --output-on-failure -j"$(nproc)" --timeout 900
+
+# The web page (issue 6): unit tests of its modules, then the browser test: balloon-server --http with
+# the built page, driven in headless Debian Chromium by playwright-core. npm ci runs only when
+# tests/web/package-lock.json changed.
+web_stamp="$BUILD_DIR/tests/web/npm-ci.stamp"
+if [[ ! -f "$web_stamp" || ! -d tests/web/node_modules || tests/web/package-lock.json -nt "$web_stamp" ]]; then
+  (cd tests/web && npm ci --no-audit --no-fund --loglevel=error)
+  mkdir -p "$(dirname "$web_stamp")"
+  touch "$web_stamp"
+fi
+node --test --test-reporter=spec tests/web/page_modules_test.mjs
+node tests/web/browser_test.mjs --server "$BUILD_DIR/server/balloon-server" \
+  --web-root "$BUILD_DIR/client/web/dist" --artifacts "$BUILD_DIR/test-artifacts/web"

@@ -8,6 +8,7 @@
 #include <iostream>
 #include <mutex>
 
+#include "http/http_gateway.hpp"
 #include "rpc/grpc_server.hpp"
 #include "server_flags.hpp"
 
@@ -48,6 +49,9 @@ int main(int argc, char** argv) {
   sigaddset(&signals, SIGTERM);
   sigaddset(&signals, SIGINT);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  // A browser that goes away mid-response must cost a failed write, not the process (httplib sends
+  // without MSG_NOSIGNAL).
+  signal(SIGPIPE, SIG_IGN);
 
   balloon::rpc::ServerConfig config = command->config;
   if (!command->quiet) config.service.log = log_line;
@@ -62,15 +66,39 @@ int main(int argc, char** argv) {
     where.resize(where.rfind(':') + 1);
     where.append(std::to_string((*server)->port()));
   }
+  std::unique_ptr<balloon::http::HttpGateway> gateway;
+  if (!command->http_address.empty()) {
+    balloon::http::HttpGatewayOptions options;
+    options.address = command->http_address;
+    options.web_root = command->web_root;
+    options.max_body_bytes = static_cast<std::size_t>(config.max_message_bytes);
+    options.log = log_line;
+    auto started = balloon::http::HttpGateway::start(options, (*server)->in_process_channel());
+    if (!started) {
+      std::fprintf(stderr, "balloon-server: error: %s\n", started.error().c_str());
+      (*server)->shutdown(1.0);
+      return 1;
+    }
+    gateway = std::move(*started);
+  }
   std::printf("balloon-server listening on %s (db %s, %d workers, %s%s)\n", where.c_str(),
               config.service.db_path.c_str(), config.service.workers,
               config.token_file.empty() ? "no authentication" : "token authentication",
               config.tls_cert_file.empty() ? "" : ", TLS");
+  if (gateway) {
+    std::string http_where = command->http_address;
+    http_where.resize(http_where.rfind(':') + 1);
+    http_where.append(std::to_string(gateway->port()));
+    std::printf("balloon-server http on %s (web root %s)\n", http_where.c_str(), command->web_root.c_str());
+  }
+  // One flush for both lines: readers that stop after the first line still find the pipe's whole write.
   std::fflush(stdout);
 
   int received = 0;
   sigwait(&signals, &received);
   log_line(std::string("received ") + (received == SIGTERM ? "SIGTERM" : "SIGINT") + "; shutting down");
+  // The gateway first: it ends its event streams and stops taking requests while the service still answers.
+  if (gateway) gateway->stop();
   (*server)->shutdown(5.0);
   server->reset();  // closes the store
   log_line("stopped");

@@ -17,6 +17,7 @@ const std::map<std::string, bool>& known_flags() {
       {"token-file", true},   {"tls-cert", true},     {"tls-key", true},     {"insecure-listen-any", false},
       {"max-message-mb", true}, {"max-mesh-vertices", true}, {"job-time-limit", true},
       {"progress-mesh-every", true}, {"quiet", false}, {"config", true}, {"help", false},
+      {"http", true},         {"web-root", true},
   };
   return flags;
 }
@@ -71,6 +72,14 @@ Result<bool> read_config_file(const std::string& path, std::vector<std::pair<std
 
 }  // namespace
 
+std::string default_web_root() {
+#ifdef BALLOON_WEB_ROOT
+  return BALLOON_WEB_ROOT;
+#else
+  return "web";
+#endif
+}
+
 std::string server_usage() {
   return "Usage: balloon-server [--listen ADDR] [--db PATH] [--workers N] [--max-queue N] [--token-file F]\n"
          "                      [--tls-cert F --tls-key F] [options]\n\n"
@@ -88,11 +97,15 @@ std::string server_usage() {
          "  --progress-mesh-every K  stream the intermediate mesh every K shape updates [1]\n"
          "  --token-file F           require 'authorization: Bearer <token>'; lines 'TENANT TOKEN' [none]\n"
          "  --tls-cert F, --tls-key F  serve TLS with this PEM certificate chain and key [plaintext]\n"
-         "  --insecure-listen-any    allow a non-loopback address without a token file [off]\n"
+         "  --http HOST:PORT         also serve the JSON API (/api/v1) and the web page over HTTP on this\n"
+         "                           address, e.g. 127.0.0.1:8080; port 0 picks one [off]\n"
+         "  --web-root DIR           the web page's files [" + default_web_root() + "]\n"
+         "  --insecure-listen-any    allow non-loopback --listen/--http addresses without a token file [off]\n"
          "  --quiet                  no per-job log lines on stderr [off]\n"
          "  --config FILE            read 'name = value' settings first (names as the flags) [none]\n"
          "  --help                   this text\n\n"
-         "Health checking (grpc.health.v1) and server reflection are enabled.\n";
+         "Health checking (grpc.health.v1) and server reflection are enabled. The HTTP API calls the same\n"
+         "service in-process: same tokens ('Authorization: Bearer <token>'), limits and messages.\n";
 }
 
 Result<ServerCommand> parse_server_flags(const std::vector<std::string>& args) {
@@ -135,6 +148,8 @@ Result<ServerCommand> parse_server_flags(const std::vector<std::string>& args) {
     else if (name == "token-file") config.token_file = value;
     else if (name == "tls-cert") config.tls_cert_file = value;
     else if (name == "tls-key") config.tls_key_file = value;
+    else if (name == "http") command.http_address = value;
+    else if (name == "web-root") command.web_root = value;
     else if (name == "workers") {
       Result<long long> n = to_integer(name, value, 1, 1024);
       if (!n) return fail(n.error());
@@ -161,6 +176,13 @@ Result<ServerCommand> parse_server_flags(const std::vector<std::string>& args) {
       config.service.progress_mesh_every = static_cast<int>(*n);
     }
   }
+  if (command.web_root.empty()) command.web_root = default_web_root();
+  // The same rule as for --listen (GrpcServer::start): a port anyone can reach needs tokens.
+  if (!command.http_address.empty() && config.token_file.empty() && !config.insecure_listen_any &&
+      !rpc::is_loopback_address(command.http_address))
+    return fail("refusing to serve HTTP on '" + command.http_address +
+                "' without --token-file (anyone could submit jobs); use a loopback address, a token file, or "
+                "--insecure-listen-any");
   if (config.service.workers <= 0) config.service.workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   return command;
 }

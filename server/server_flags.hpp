@@ -11,6 +11,8 @@ namespace balloon::server {
 /// What the command line asked for.
 struct ServerCommand {
   rpc::ServerConfig config;
+  std::string http_address;  ///< --http HOST:PORT: also serve the JSON API and the page; empty: no HTTP
+  std::string web_root;      ///< --web-root DIR: the page's files (default: the page CMake built)
   bool help = false;   ///< print server_usage() and exit
   bool quiet = false;  ///< no per-job log lines
 };
@@ -18,6 +20,9 @@ struct ServerCommand {
 /// Parses the words after the program name. `--config FILE` reads `name = value` lines (names as the
 /// flags without dashes; `#` comments) before the remaining flags, which override it.
 Result<ServerCommand> parse_server_flags(const std::vector<std::string>& args);
+
+/// The compiled-in --web-root default (BALLOON_WEB_ROOT: <build>/client/web/dist).
+std::string default_web_root();
 
 /// The --help text, with every flag's default.
 std::string server_usage();

@@ -355,16 +355,12 @@ int run_design_command(const std::vector<std::string>& args) {
     return report_error(COMMAND, problem, EXIT_INTERNAL);
   if (problem = write("convergence.csv", jobs::convergence_csv(convergence_from_report(report))); !problem.empty())
     return report_error(COMMAND, problem, EXIT_INTERNAL);
-  // The mold is built here from the stored rest mesh with the tube the job chose (jobs::design_mold is
-  // the one place that builds it), since the store keeps meshes and the report only.
+  // The mold is built here from the stored rest mesh with the tube the job chose (jobs::mold_from_report
+  // is the one place that builds it, for the web gateway too), since the store keeps meshes and the report only.
   if (const Value* mold = field(report, "mold"); mold != nullptr && mold->has_struct_value()) {
-    jobs::MoldParameters parameters;
-    parameters.nozzle_vertex = static_cast<int>(std::lround(number_field(mold->struct_value(), "nozzle_vertex")));
-    parameters.tube_radius_mm = number_field(mold->struct_value(), "tube_radius_mm");
-    parameters.tube_length_mm = number_field(mold->struct_value(), "tube_length_mm");
     Result<TriMesh> rest = read_mesh_from_memory(result.rest_mesh().data(), "obj");
     if (!rest) return report_error(COMMAND, "rest mesh from the service: " + rest.error(), EXIT_INTERNAL);
-    Result<TriMesh> built = jobs::design_mold(*rest, parameters);
+    Result<TriMesh> built = jobs::mold_from_report(*rest, result.report_json());
     if (!built) {
       std::fprintf(stderr, "balloon design: warning: mold.stl not written: %s\n", built.error().c_str());
     } else if (problem = write("mold.stl", write_mesh_to_memory(*built, "stl")); !problem.empty()) {

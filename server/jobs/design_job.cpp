@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "design/mold.hpp"
+#include "jobs/json_reader.hpp"
 #include "jobs/json_writer.hpp"
 #include "mesh/mesh_geometry.hpp"
 
@@ -118,6 +119,35 @@ Result<TriMesh> design_mold(const TriMesh& rest, const MoldParameters& mold) {
     return fail("mold nozzle vertex " + std::to_string(mold.nozzle_vertex) + " is not a vertex of the rest mesh");
   const Eigen::Vector3d center = rest.vertices.row(mold.nozzle_vertex).transpose();
   return build_mold(rest, center, mold.tube_radius_mm, mold.tube_length_mm);
+}
+
+Result<TriMesh> mold_from_report(const TriMesh& rest, const std::string& report_json) {
+  Result<JsonValue> report = parse_json(report_json);
+  if (!report) return fail("the design report: " + report.error());
+  const JsonValue* mold = report->find("mold");
+  if (mold == nullptr || mold->kind != JsonValue::Kind::Object) {
+    const JsonValue* problem = report->find("mold_problem");
+    if (problem != nullptr && problem->kind == JsonValue::Kind::String && !problem->text.empty())
+      return fail("the design has no mold: " + problem->text);
+    return fail("the design report has no mold");
+  }
+  const auto number = [&](const char* key) -> Result<double> {
+    const JsonValue* value = mold->find(key);
+    if (value == nullptr || value->kind != JsonValue::Kind::Number || !std::isfinite(value->number))
+      return fail(std::string("the design report's mold has no number '") + key + "'");
+    return value->number;
+  };
+  Result<double> vertex = number("nozzle_vertex");
+  Result<double> radius = number("tube_radius_mm");
+  Result<double> length = number("tube_length_mm");
+  if (!vertex) return fail(vertex.error());
+  if (!radius) return fail(radius.error());
+  if (!length) return fail(length.error());
+  MoldParameters parameters;
+  parameters.nozzle_vertex = static_cast<int>(std::lround(*vertex));
+  parameters.tube_radius_mm = *radius;
+  parameters.tube_length_mm = *length;
+  return design_mold(rest, parameters);
 }
 
 DesignOutcome run_design(const DesignInput& input, const RunControls& controls) {

@@ -84,6 +84,12 @@ DesignOutcome run_design(const DesignInput& input, const RunControls& controls);
 /// client builds mold.stl from the rest mesh and the report's "mold" object through this same function.
 Result<TriMesh> design_mold(const TriMesh& rest, const MoldParameters& mold);
 
+/// mold.stl's mesh from a finished design as the store keeps it: `rest` is the job's rest mesh (mm) and
+/// `report_json` its report (design_report_json), whose "mold" object names the tube. The one function
+/// the CLI and the HTTP gateway both build the mold with. Fails when the report has no mold (the message
+/// then carries the report's mold_problem), is not a design report, or the tube cannot be built.
+Result<TriMesh> mold_from_report(const TriMesh& rest, const std::string& report_json);
+
 /// One JSON object. Issue 4's keys: converged, method, avg_error_mm, max_error_mm, avg_error_rel,
 /// max_error_rel, bbox_diag_mm, pressure_kpa, volume_ratio, iterations, time_s, vertices, active_terms,
 /// baseline_avg_error_mm, baseline_max_error_mm; also faces, material, material_name, thickness_mm,

@@ -13,6 +13,7 @@
 #include <memory>
 #include <sstream>
 
+#include "jobs/json_reader.hpp"
 #include "jobs/json_writer.hpp"
 #include "material/bulge_test.hpp"
 
@@ -150,138 +151,6 @@ int best_fit_index(const FitOutcome& outcome) {
 
 namespace {
 
-/// A parsed JSON value: just enough JSON to read back what JsonWriter wrote.
-struct JsonValue {
-  enum class Kind { Null, Bool, Number, String, Array, Object } kind = Kind::Null;
-  bool boolean = false;
-  double number = 0.0;
-  std::string text;
-  std::vector<JsonValue> items;                 ///< array elements
-  std::vector<std::pair<std::string, JsonValue>> members;  ///< object members in order
-
-  const JsonValue* find(const std::string& key) const {
-    for (const auto& [name, value] : members)
-      if (name == key) return &value;
-    return nullptr;
-  }
-};
-
-class JsonParser {
- public:
-  explicit JsonParser(const std::string& text) : m_text(text) {}
-
-  Result<JsonValue> parse_document() {
-    JsonValue value;
-    if (!parse_value(value, 0)) return fail("the fit report is not valid JSON (at byte " + std::to_string(m_at) + ")");
-    skip_space();
-    if (m_at != m_text.size()) return fail("the fit report has trailing bytes");
-    return value;
-  }
-
- private:
-  static constexpr int MAX_DEPTH = 32;
-
-  void skip_space() {
-    while (m_at < m_text.size() && std::isspace(static_cast<unsigned char>(m_text[m_at]))) ++m_at;
-  }
-  bool literal(const char* word) {
-    const std::string_view expected(word);
-    if (m_text.compare(m_at, expected.size(), expected) != 0) return false;
-    m_at += expected.size();
-    return true;
-  }
-  bool parse_string(std::string& out) {
-    if (m_at >= m_text.size() || m_text[m_at] != '"') return false;
-    ++m_at;
-    while (m_at < m_text.size() && m_text[m_at] != '"') {
-      char c = m_text[m_at++];
-      if (c == '\\') {
-        if (m_at >= m_text.size()) return false;
-        const char escaped = m_text[m_at++];
-        switch (escaped) {
-          case 'n': c = '\n'; break;
-          case 't': c = '\t'; break;
-          case 'r': c = '\r'; break;
-          case 'b': c = '\b'; break;
-          case 'f': c = '\f'; break;
-          case 'u': {
-            // Only the control characters JsonWriter escapes this way (< 0x20): one byte.
-            if (m_at + 4 > m_text.size()) return false;
-            c = static_cast<char>(std::stoi(m_text.substr(m_at, 4), nullptr, 16));
-            m_at += 4;
-            break;
-          }
-          default: c = escaped;  // \" \\ \/
-        }
-      }
-      out += c;
-    }
-    if (m_at >= m_text.size()) return false;
-    ++m_at;
-    return true;
-  }
-  bool parse_value(JsonValue& value, int depth) {
-    if (depth > MAX_DEPTH) return false;
-    skip_space();
-    if (m_at >= m_text.size()) return false;
-    const char c = m_text[m_at];
-    if (c == '"') {
-      value.kind = JsonValue::Kind::String;
-      return parse_string(value.text);
-    }
-    if (c == '{') {
-      value.kind = JsonValue::Kind::Object;
-      ++m_at;
-      skip_space();
-      if (m_at < m_text.size() && m_text[m_at] == '}') return ++m_at, true;
-      while (true) {
-        skip_space();
-        std::string key;
-        if (!parse_string(key)) return false;
-        skip_space();
-        if (m_at >= m_text.size() || m_text[m_at++] != ':') return false;
-        JsonValue member;
-        if (!parse_value(member, depth + 1)) return false;
-        value.members.emplace_back(std::move(key), std::move(member));
-        skip_space();
-        if (m_at >= m_text.size()) return false;
-        if (m_text[m_at] == ',') { ++m_at; continue; }
-        if (m_text[m_at] == '}') return ++m_at, true;
-        return false;
-      }
-    }
-    if (c == '[') {
-      value.kind = JsonValue::Kind::Array;
-      ++m_at;
-      skip_space();
-      if (m_at < m_text.size() && m_text[m_at] == ']') return ++m_at, true;
-      while (true) {
-        JsonValue item;
-        if (!parse_value(item, depth + 1)) return false;
-        value.items.push_back(std::move(item));
-        skip_space();
-        if (m_at >= m_text.size()) return false;
-        if (m_text[m_at] == ',') { ++m_at; continue; }
-        if (m_text[m_at] == ']') return ++m_at, true;
-        return false;
-      }
-    }
-    if (literal("null")) return value.kind = JsonValue::Kind::Null, true;
-    if (literal("true")) return value.kind = JsonValue::Kind::Bool, value.boolean = true, true;
-    if (literal("false")) return value.kind = JsonValue::Kind::Bool, value.boolean = false, true;
-    const char* begin = m_text.c_str() + m_at;
-    char* end = nullptr;
-    value.number = std::strtod(begin, &end);
-    if (end == begin) return false;
-    value.kind = JsonValue::Kind::Number;
-    m_at += static_cast<size_t>(end - begin);
-    return true;
-  }
-
-  const std::string& m_text;
-  size_t m_at = 0;
-};
-
 /// A number member; null (how JsonWriter writes non-finite numbers) reads as infinity.
 Result<double> number_member(const JsonValue& object, const std::string& key) {
   const JsonValue* value = object.find(key);
@@ -367,8 +236,8 @@ Result<FitResult> fit_from_json(const JsonValue& object, MaterialModel model, co
 }  // namespace
 
 Result<FitOutcome> fit_outcome_from_json(const FitInput& input, const std::string& report_json) {
-  Result<JsonValue> document = JsonParser(report_json).parse_document();
-  if (!document) return fail(document.error());
+  Result<JsonValue> document = parse_json(report_json);
+  if (!document) return fail("the fit report: " + document.error());
   std::vector<const JsonValue*> objects;
   if (document->kind == JsonValue::Kind::Array) {
     for (const JsonValue& item : document->items) objects.push_back(&item);
@@ -387,9 +256,10 @@ Result<FitOutcome> fit_outcome_from_json(const FitInput& input, const std::strin
   return outcome;
 }
 
-std::string fit_json(const FitResult& fit) {
-  JsonWriter json;
-  json.begin_object();
+namespace {
+
+/// The members of one fit's JSON object (see fit_json), into an open object.
+void write_fit_members(JsonWriter& json, const FitResult& fit) {
   json.value("model", model_name(fit.material.model));
   json.value("spec", material_spec(fit.material));
   const std::vector<std::string> names = parameter_names(fit.material.model);
@@ -425,16 +295,32 @@ std::string fit_json(const FitResult& fit) {
   }
   json.end_array();
   json.value("message", fit.message);
+}
+
+}  // namespace
+
+std::string fit_json(const FitResult& fit) {
+  JsonWriter json;
+  json.begin_object();
+  write_fit_members(json, fit);
   json.end_object();
   return json.str();
 }
 
 std::string fit_report_json(const FitInput& input, const FitOutcome& outcome) {
-  if (!input.all_models && outcome.fits.size() == 1) return fit_json(outcome.fits.front());
+  // The plot travels in the report so that a client without the data (the web page) can show it; it is
+  // the whole plot (every model), so in the list form only the first object carries it.
+  const std::string plot = fit_plot_svg(input, outcome);
+  const bool list = input.all_models || outcome.fits.size() != 1;
   JsonWriter json;
-  json.begin_array();
-  for (const FitResult& fit : outcome.fits) json.raw("", fit_json(fit));
-  json.end_array();
+  if (list) json.begin_array();
+  for (size_t i = 0; i < outcome.fits.size(); ++i) {
+    json.begin_object();
+    write_fit_members(json, outcome.fits[i]);
+    if (i == 0) json.value("plot_svg", plot);
+    json.end_object();
+  }
+  if (list) json.end_array();
   return json.str();
 }
 

@@ -58,7 +58,8 @@ Result<FitOutcome> fit_outcome_from_json(const FitInput& input, const std::strin
 /// One fit as a JSON object: model, spec, params (by SPEC name), std_errors, rms_residual, max_residual,
 /// residual_unit, rms_relative_residual, max_relative_residual, points, converged, regimes, sets, message.
 std::string fit_json(const FitResult& fit);
-/// The whole report: one object for a single model, a list of objects for "all".
+/// The whole report: one object for a single model, a list of objects for "all". The (first) object
+/// also carries `plot_svg`, the fit_plot_svg of the whole outcome, for clients without the data.
 std::string fit_report_json(const FitInput& input, const FitOutcome& outcome);
 /// A few human-readable lines per model, with units.
 std::string fit_summary_text(const FitInput& input, const FitOutcome& outcome);

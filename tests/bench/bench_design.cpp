@@ -1,10 +1,10 @@
 // Inverse-design benchmark (issue 4): per sample shape (bunny, spot, blob at a 100 mm bounding-box
-// diagonal, remeshed to --resolution vertices, silicone, volume ratio 8) and per method (adjoint, alm):
+// diagonal, remeshed to --resolution vertices, silicone, --volume-ratio 8) and per method (adjoint, alm):
 // vertices, time, iterations, average and maximum error, and the baseline error (the downscaled target
 // inflated). Writes the error-against-time curves as CSV (one file per shape and method) and one SVG
 // plot per shape into OUT_DIR, and compares the run times with the paper's Table 1.
 // Usage: bench_design [OUT_DIR=./bench-design-out] [--data DIR] [--resolution N=3000] [--max-time S=60]
-//                     [--quick]   (--quick: bunny only, 1000 vertices, 20 s per design)
+//                     [--volume-ratio R=8] [--method adjoint|alm (default: both)] [--quick]   (--quick: bunny only, 1000 vertices, 20 s per design)
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -105,6 +105,9 @@ int main(int argc, char** argv) {
   int resolution = 3000;
   double max_time_s = 60.0;
   bool quick = false;
+  double volume_ratio = 8.0;
+  std::vector<balloon::DesignMethod> methods = {balloon::DesignMethod::Adjoint,
+                                                balloon::DesignMethod::AugmentedLagrangian};
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--quick") {
@@ -115,10 +118,19 @@ int main(int argc, char** argv) {
       resolution = std::atoi(argv[++i]);
     } else if (arg == "--max-time" && i + 1 < argc) {
       max_time_s = std::atof(argv[++i]);
+    } else if (arg == "--method" && i + 1 < argc) {
+      const auto method = balloon::parse_design_method(argv[++i]);
+      if (!method) {
+        std::fprintf(stderr, "bench_design: %s\n", method.error().c_str());
+        return 2;
+      }
+      methods = {*method};
+    } else if (arg == "--volume-ratio" && i + 1 < argc) {
+      volume_ratio = std::atof(argv[++i]);
     } else if (!arg.empty() && arg[0] != '-') {
       out_dir = arg;
     } else {
-      std::fprintf(stderr, "usage: bench_design [OUT_DIR] [--data DIR] [--resolution N] [--max-time S] [--quick]\n");
+      std::fprintf(stderr, "usage: bench_design [OUT_DIR] [--data DIR] [--resolution N] [--max-time S] [--volume-ratio R] [--method adjoint|alm] [--quick]\n");
       return 2;
     }
   }
@@ -136,9 +148,9 @@ int main(int argc, char** argv) {
                                {"blob", "retinal_bumpy_blob.off"}};
   if (quick) shapes.resize(1);
 
-  std::printf("inverse design: %s, thickness 0.5 mm, volume ratio 8, 100 mm bbox diagonal, ~%d vertices, "
+  std::printf("inverse design: %s, thickness 0.5 mm, volume ratio %g, 100 mm bbox diagonal, ~%d vertices, "
               "budget %.0f s per design\n",
-              balloon::material_spec(*material).c_str(), resolution, max_time_s);
+              balloon::material_spec(*material).c_str(), volume_ratio, resolution, max_time_s);
   std::printf("%-6s %-8s %8s %9s %6s %11s %11s %9s %12s %12s %9s  %s\n", "shape", "method", "vertices", "time_s",
               "iters", "avg_err_mm", "max_err_mm", "avg_%diag", "base_avg_mm", "base_max_mm", "improve", "status");
   std::vector<Run> runs;
@@ -157,7 +169,7 @@ int main(int argc, char** argv) {
       continue;
     }
     std::vector<const Run*> shape_runs;
-    for (const auto method : {balloon::DesignMethod::Adjoint, balloon::DesignMethod::AugmentedLagrangian}) {
+    for (const auto method : methods) {
       // A method the optimizer does not offer (yet) is reported, not run under another name.
       const std::string method_name = balloon::design_method_name(method);
       if (auto offered = balloon::parse_design_method(method_name); !offered) {
@@ -167,7 +179,7 @@ int main(int argc, char** argv) {
       balloon::DesignOptions options;
       options.material = *material;
       options.thickness_mm = 0.5;
-      options.volume_ratio = 8.0;
+      options.volume_ratio = volume_ratio;
       options.method = method;
       options.max_time_s = max_time_s;
       runs.push_back({shape.name, balloon::design_balloon(target->mesh, options)});

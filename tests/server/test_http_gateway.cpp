@@ -1,0 +1,772 @@
+// The HTTP/JSON gateway (README.md, "HTTP/JSON API"): a real balloon-server with `--http 127.0.0.1:0`, driven with
+// cpp-httplib's client as a browser would, and compared with the gRPC API of the same server.
+#include <gtest/gtest.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include <google/protobuf/struct.pb.h>
+#include <google/protobuf/util/json_util.h>
+#include <grpcpp/grpcpp.h>
+
+#include "balloon/v1/balloon.grpc.pb.h"
+#include "http/json_mapping.hpp"
+#include "http/static_files.hpp"
+#include "jobs/design_job.hpp"
+#include "jobs/fit_job.hpp"
+#include "jobs/json_reader.hpp"
+#include "mesh/icosphere.hpp"
+#include "mesh/mesh_io.hpp"
+
+// Last: httplib.h pulls in <resolv.h>, whose `_res` macro breaks Eigen's headers if they come after it.
+#include <httplib.h>
+
+namespace balloon::testing {
+namespace {
+
+namespace v1 = balloon::v1;
+using Clock = std::chrono::steady_clock;
+
+// A server that answers early (413) and closes must fail the client's write, not kill the test process.
+const bool SIGPIPE_IGNORED = (signal(SIGPIPE, SIG_IGN), true);
+
+class ScratchDir {
+ public:
+  ScratchDir() {
+    std::string pattern = (std::filesystem::temp_directory_path() / "balloon-http-XXXXXX").string();
+    if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
+    m_path = pattern;
+  }
+  ~ScratchDir() {
+    std::error_code ignored;
+    std::filesystem::remove_all(m_path, ignored);
+  }
+  std::string file(const std::string& name) const { return (m_path / name).string(); }
+
+ private:
+  std::filesystem::path m_path;
+};
+
+/// A balloon-server child with `--listen 127.0.0.1:0 --http 127.0.0.1:0`; reads both ports from stdout.
+class HttpServer {
+ public:
+  HttpServer(const ScratchDir& scratch, const std::vector<std::string>& extra_args) {
+    m_log_path = scratch.file("server.log");
+    int out_pipe[2];
+    if (pipe(out_pipe) != 0) throw std::runtime_error("pipe failed");
+    std::vector<std::string> args = {BALLOON_SERVER_PATH, "--listen", "127.0.0.1:0", "--db", scratch.file("jobs.db"),
+                                     "--http", "127.0.0.1:0"};
+    args.insert(args.end(), extra_args.begin(), extra_args.end());
+    m_pid = fork();
+    if (m_pid < 0) throw std::runtime_error("fork failed");
+    if (m_pid == 0) {
+      dup2(out_pipe[1], STDOUT_FILENO);
+      const int log_fd = open(m_log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+      if (log_fd >= 0) dup2(log_fd, STDERR_FILENO);
+      close(out_pipe[0]);
+      close(out_pipe[1]);
+      std::vector<char*> argv;
+      for (std::string& arg : args) argv.push_back(arg.data());
+      argv.push_back(nullptr);
+      execv(argv[0], argv.data());
+      _exit(127);
+    }
+    close(out_pipe[1]);
+    const auto deadline = Clock::now() + std::chrono::seconds(20);
+    while (m_output.find("http on") == std::string::npos || m_output.find('\n', m_output.find("http on")) == std::string::npos) {
+      if (Clock::now() > deadline) break;
+      pollfd fd{out_pipe[0], POLLIN, 0};
+      if (poll(&fd, 1, 200) <= 0) continue;
+      char buffer[512];
+      const ssize_t n = read(out_pipe[0], buffer, sizeof(buffer));
+      if (n <= 0) break;
+      m_output.append(buffer, static_cast<std::size_t>(n));
+    }
+    close(out_pipe[0]);
+    const std::string grpc_marker = "listening on 127.0.0.1:", http_marker = "http on 127.0.0.1:";
+    const auto grpc_at = m_output.find(grpc_marker), http_at = m_output.find(http_marker);
+    if (grpc_at == std::string::npos || http_at == std::string::npos) {
+      stop(SIGKILL);
+      throw std::runtime_error("balloon-server did not start: " + m_output + log());
+    }
+    m_grpc_port = std::stoi(m_output.substr(grpc_at + grpc_marker.size()));
+    m_http_port = std::stoi(m_output.substr(http_at + http_marker.size()));
+  }
+  ~HttpServer() {
+    if (m_pid > 0) stop(SIGTERM);
+  }
+
+  int http_port() const { return m_http_port; }
+  const std::string& output() const { return m_output; }
+  /// A fresh HTTP client (a browser tab).
+  std::unique_ptr<httplib::Client> client() const {
+    auto client = std::make_unique<httplib::Client>("127.0.0.1", m_http_port);
+    client->set_read_timeout(30, 0);
+    return client;
+  }
+  std::unique_ptr<v1::BalloonService::Stub> stub() const {
+    grpc::ChannelArguments arguments;
+    arguments.SetMaxReceiveMessageSize(-1);
+    return v1::BalloonService::NewStub(grpc::CreateCustomChannel(
+        "127.0.0.1:" + std::to_string(m_grpc_port), grpc::InsecureChannelCredentials(), arguments));
+  }
+  int stop(int signal) {
+    if (m_pid <= 0) return -1;
+    kill(m_pid, signal);
+    int status = 0;
+    waitpid(m_pid, &status, 0);
+    m_pid = -1;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  }
+  std::string log() const {
+    std::ifstream in(m_log_path);
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+  }
+
+ private:
+  pid_t m_pid = -1;
+  int m_grpc_port = 0;
+  int m_http_port = 0;
+  std::string m_output;
+  std::string m_log_path;
+};
+
+/// Runs balloon-server with `args` to its exit; returns the exit code and fills `output` (stdout + stderr).
+int run_server(const std::vector<std::string>& args, std::string* output) {
+  std::string command = BALLOON_SERVER_PATH;
+  for (const std::string& arg : args) command += " '" + arg + "'";
+  command += " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return -1;
+  char buffer[512];
+  while (const size_t n = fread(buffer, 1, sizeof(buffer), pipe)) output->append(buffer, n);
+  const int status = pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string base64(const std::string& bytes) {
+  static constexpr char TABLE[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  size_t i = 0;
+  for (; i + 2 < bytes.size(); i += 3) {
+    const unsigned n = (static_cast<unsigned char>(bytes[i]) << 16) | (static_cast<unsigned char>(bytes[i + 1]) << 8) |
+                       static_cast<unsigned char>(bytes[i + 2]);
+    for (int shift : {18, 12, 6, 0}) out += TABLE[(n >> shift) & 63];
+  }
+  if (i < bytes.size()) {
+    unsigned n = static_cast<unsigned char>(bytes[i]) << 16;
+    if (i + 1 < bytes.size()) n |= static_cast<unsigned char>(bytes[i + 1]) << 8;
+    out += TABLE[(n >> 18) & 63];
+    out += TABLE[(n >> 12) & 63];
+    out += i + 1 < bytes.size() ? TABLE[(n >> 6) & 63] : '=';
+    out += '=';
+  }
+  return out;
+}
+
+std::string sphere_obj(int subdivisions, double radius_mm = 10.0) {
+  return write_mesh_to_memory(make_icosphere(radius_mm, subdivisions), "obj");
+}
+
+/// A SubmitJobRequest body for a simulate job, built as the page builds it (JSON by hand).
+std::string simulate_body(const std::string& obj, const std::string& control,
+                          const std::string& material = R"("name":"latex")") {
+  return R"({"spec":{"simulate":{"rest_mesh":{"data":")" + base64(obj) + R"(","format":"MESH_FORMAT_OBJ"},"material":{)" +
+         material + R"(},"thickness_mm":0.5,)" + control + "}}}";
+}
+
+/// A job that keeps the only worker busy for well over a minute until cancelled (cancellation takes one
+/// solver iteration, ~0.1 s): a design of the bunny remeshed to 4000 vertices with a 60 s budget.
+std::string busy_job_body() {
+  std::ifstream in(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/stanford_bunny_1839.obj", std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return R"({"spec":{"design":{"target_mesh":{"data":")" + base64(bytes.str()) +
+         R"(","format":"MESH_FORMAT_OBJ"},"material":{"name":"latex"},"resolution":4000,"max_time_s":60}}})";
+}
+
+template <class Message>
+Message parse(const std::string& json) {
+  Message message;
+  const auto status = google::protobuf::util::JsonStringToMessage(json, &message);
+  EXPECT_TRUE(status.ok()) << status.ToString() << " in " << json.substr(0, 300);
+  return message;
+}
+
+/// The API's error body {"error":{"code","message"}} as (code, message).
+std::pair<std::string, std::string> error_of(const httplib::Result& response) {
+  if (!response) return {"<no response>", ""};
+  const auto body = parse<google::protobuf::Struct>(response->body);
+  const auto& error = body.fields().at("error").struct_value().fields();
+  return {error.at("code").string_value(), error.at("message").string_value()};
+}
+
+const httplib::Headers JSON_ACCEPT = {{"Accept", "application/json"}};
+
+std::string submit(httplib::Client& client, const std::string& body, const httplib::Headers& headers = {}) {
+  const auto response = client.Post("/api/v1/jobs", headers, body, "application/json");
+  EXPECT_TRUE(response && response->status == 200) << (response ? response->body : "no response");
+  if (!response || response->status != 200) return "";
+  return parse<v1::SubmitJobResponse>(response->body).job().id();
+}
+
+struct SseEvent {
+  std::string type;
+  std::string data;
+};
+
+/// The events of a whole stream body ("event: T\ndata: D\n\n" blocks; comments skipped).
+std::vector<SseEvent> parse_sse(const std::string& body) {
+  std::vector<SseEvent> events;
+  std::istringstream lines(body);
+  std::string line;
+  SseEvent current;
+  while (std::getline(lines, line)) {
+    if (line.empty()) {
+      if (!current.type.empty() || !current.data.empty()) events.push_back(current);
+      current = SseEvent();
+    } else if (line.rfind("event: ", 0) == 0) {
+      current.type = line.substr(7);
+    } else if (line.rfind("data: ", 0) == 0) {
+      current.data += line.substr(6);
+    }
+  }
+  return events;
+}
+
+/// GET .../events to the end; returns the events. `status` gets the HTTP status.
+std::vector<SseEvent> watch(httplib::Client& client, const std::string& job_id, int* status,
+                            const httplib::Headers& headers = {}) {
+  std::string body;
+  const auto response = client.Get("/api/v1/jobs/" + job_id + "/events", headers,
+                                   [&](const char* data, size_t length) {
+                                     body.append(data, length);
+                                     return true;
+                                   });
+  *status = response ? response->status : -1;
+  if (response && response->status != 200) return {};
+  return parse_sse(body);
+}
+
+// --- pieces without a server ----------------------------------------------------------------------
+
+TEST(HttpGateway, StatusCodesMapAsTheContractSays) {
+  using grpc::StatusCode;
+  const std::vector<std::pair<StatusCode, int>> table = {
+      {StatusCode::OK, 200},          {StatusCode::INVALID_ARGUMENT, 400},   {StatusCode::UNAUTHENTICATED, 401},
+      {StatusCode::PERMISSION_DENIED, 403}, {StatusCode::NOT_FOUND, 404},    {StatusCode::FAILED_PRECONDITION, 409},
+      {StatusCode::RESOURCE_EXHAUSTED, 413}, {StatusCode::CANCELLED, 499},   {StatusCode::UNIMPLEMENTED, 501},
+      {StatusCode::UNAVAILABLE, 503}, {StatusCode::INTERNAL, 500},           {StatusCode::DEADLINE_EXCEEDED, 500},
+      {StatusCode::ALREADY_EXISTS, 500}};
+  for (const auto& [code, http] : table) EXPECT_EQ(http::http_status_for(code), http) << http::status_code_name(code);
+  EXPECT_EQ(http::error_body(StatusCode::NOT_FOUND, "no job \"x\""),
+            R"({"error":{"code":"NOT_FOUND","message":"no job \"x\""}})");
+}
+
+TEST(HttpGateway, StaticLookupRefusesTraversalAndFindsIndexFiles) {
+  ScratchDir scratch;
+  const std::string root = scratch.file("www");
+  std::filesystem::create_directories(root + "/sub");
+  std::ofstream(root + "/index.html") << "<html>";
+  std::ofstream(root + "/sub/index.html") << "<html>sub";
+  EXPECT_EQ(http::find_static_file(root, "/").file, root + "/index.html");
+  EXPECT_EQ(http::find_static_file(root, "/sub/").file, root + "/sub/index.html");
+  EXPECT_EQ(http::find_static_file(root, "/sub").file, root + "/sub/index.html");
+  EXPECT_EQ(http::find_static_file(root, "/nope.js").http_status, 404);
+  for (const char* bad : {"/../jobs.db", "/sub/../../x", "/..", "/a\\..\\b", "relative"})
+    EXPECT_EQ(http::find_static_file(root, bad).http_status, 400) << bad;
+  const http::StaticLookup unbuilt = http::find_static_file(scratch.file("missing"), "/");
+  EXPECT_EQ(unbuilt.http_status, 404);
+  EXPECT_NE(unbuilt.message.find("not built"), std::string::npos) << unbuilt.message;
+  EXPECT_EQ(http::content_type_for("a/b.JS"), "text/javascript; charset=utf-8");
+  EXPECT_EQ(http::content_type_for("m.stl"), "model/stl");
+}
+
+TEST(HttpGateway, JsonReaderReadsWhatTheReportsHoldAndRefusesBrokenText) {
+  const Result<jobs::JsonValue> value =
+      jobs::parse_json(R"({"a":[1,-2.5e3,true,null],"s":"x\"\\\u00e9\ud83d\ude00\n","o":{}})");
+  ASSERT_TRUE(value.ok()) << value.error();
+  ASSERT_NE(value->find("a"), nullptr);
+  EXPECT_EQ(value->find("a")->items.size(), 4u);
+  EXPECT_DOUBLE_EQ(value->find("a")->items[1].number, -2500.0);
+  EXPECT_EQ(value->find("s")->text, "x\"\\\xc3\xa9\xf0\x9f\x98\x80\n");
+  for (const char* bad : {"", "{", "{\"a\":}", "[1,]", "{\"a\":1} x", "+1", "\"\x01\""})
+    EXPECT_FALSE(jobs::parse_json(bad).ok()) << bad;
+}
+
+TEST(HttpGateway, MoldFromReportNamesWhyThereIsNoMold) {
+  const TriMesh rest = make_icosphere(10.0, 2);
+  const Result<TriMesh> none = jobs::mold_from_report(rest, R"({"mold_problem":"no nozzle for the mold: too flat"})");
+  ASSERT_FALSE(none.ok());
+  EXPECT_NE(none.error().find("too flat"), std::string::npos) << none.error();
+  EXPECT_FALSE(jobs::mold_from_report(rest, "not json").ok());
+  EXPECT_FALSE(jobs::mold_from_report(rest, R"({"mold":{"nozzle_vertex":5}})").ok());
+  const Result<TriMesh> mold =
+      jobs::mold_from_report(rest, R"({"mold":{"nozzle_vertex":0,"tube_radius_mm":1.5,"tube_length_mm":4}})");
+  ASSERT_TRUE(mold.ok()) << mold.error();
+  EXPECT_GT(mold->vertex_count(), rest.vertex_count());
+}
+
+// --- a real server ----------------------------------------------------------------------------------
+
+TEST(HttpGateway, MaterialsAreListedReadWrittenAndDeletedAsJson) {
+  ScratchDir scratch;
+  HttpServer server(scratch, {"--quiet", "--workers", "1"});
+  EXPECT_NE(server.output().find("(web root "), std::string::npos) << server.output();
+  auto client = server.client();
+  auto health = client->Get("/api/v1/health");
+  ASSERT_TRUE(health);
+  EXPECT_EQ(health->body, R"({"status":"ok"})");
+
+  auto listed = client->Get("/api/v1/materials", JSON_ACCEPT);
+  ASSERT_TRUE(listed);
+  EXPECT_EQ(listed->status, 200);
+  EXPECT_EQ(listed->get_header_value("Content-Type"), "application/json");
+  // Proto field names, int64 as strings, every primitive printed.
+  EXPECT_NE(listed->body.find(R"("created_ms":"0")"), std::string::npos) << listed->body.substr(0, 300);
+  const auto materials = parse<v1::ListMaterialsResponse>(listed->body);
+  ASSERT_GE(materials.materials_size(), 2);
+  EXPECT_EQ(materials.materials(0).name(), "silicone");
+  EXPECT_TRUE(materials.materials(0).preset());
+
+  auto put = client->Put("/api/v1/materials/soft", R"({"spec":"neo-hookean:mu=0.25","description":"test"})",
+                         "application/json");
+  ASSERT_TRUE(put);
+  ASSERT_EQ(put->status, 200) << put->body;
+  EXPECT_EQ(parse<v1::Material>(put->body).model(), "neo-hookean");
+  auto got = client->Get("/api/v1/materials/soft");
+  ASSERT_TRUE(got);
+  EXPECT_DOUBLE_EQ(parse<v1::Material>(got->body).params().at("mu"), 0.25);
+  auto renamed = client->Put("/api/v1/materials/soft", R"({"name":"other","spec":"neo-hookean:mu=0.25"})",
+                             "application/json");
+  ASSERT_TRUE(renamed);
+  EXPECT_EQ(renamed->status, 400);
+  EXPECT_EQ(error_of(renamed).first, "INVALID_ARGUMENT");
+  auto preset = client->Delete("/api/v1/materials/latex");
+  ASSERT_TRUE(preset);
+  EXPECT_EQ(preset->status, 403);
+  EXPECT_EQ(error_of(preset).first, "PERMISSION_DENIED");
+  auto deleted = client->Delete("/api/v1/materials/soft");
+  ASSERT_TRUE(deleted);
+  EXPECT_EQ(deleted->status, 200);
+  EXPECT_EQ(deleted->body, "{}");
+  auto gone = client->Get("/api/v1/materials/soft");
+  ASSERT_TRUE(gone);
+  EXPECT_EQ(gone->status, 404);
+}
+
+TEST(HttpGateway, SimulateJobStreamsProgressAndServesItsMeshes) {
+  ScratchDir scratch;
+  HttpServer server(scratch, {"--quiet", "--workers", "1"});
+  auto client = server.client();
+  const TriMesh sphere = make_icosphere(10.0, 3);  // 642 vertices
+  // The only worker is busy until the stream is open, so the stream sees the job from its start.
+  const std::string busy = submit(*client, busy_job_body());
+  // Pressure control walks the volume path in steps: several progress events with shapes.
+  const std::string job_id = submit(*client, simulate_body(write_mesh_to_memory(sphere, "obj"), R"("pressure_kpa":18)",
+                                                           R"("spec":"neo-hookean:mu=0.3")"));
+  ASSERT_FALSE(busy.empty());
+  ASSERT_FALSE(job_id.empty());
+
+  std::string body;
+  std::atomic<bool> opened{false};
+  int status = 0;
+  std::thread watcher([&] {
+    auto tab = server.client();
+    const auto response = tab->Get("/api/v1/jobs/" + job_id + "/events", [&](const char* data, size_t length) {
+      body.append(data, length);
+      opened = true;
+      return true;
+    });
+    status = response ? response->status : -1;
+  });
+  const auto deadline = Clock::now() + std::chrono::seconds(10);
+  while (!opened && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  auto cancelled = client->Post("/api/v1/jobs/" + busy + "/cancel", "", "application/json");
+  ASSERT_TRUE(cancelled);
+  EXPECT_EQ(cancelled->status, 200);
+  watcher.join();
+  ASSERT_EQ(status, 200);
+  const std::vector<SseEvent> events = parse_sse(body);
+  ASSERT_FALSE(events.empty());
+  EXPECT_EQ(parse<v1::JobEvent>(events.front().data).state(), v1::JOB_STATE_QUEUED);
+  ASSERT_GE(events.size(), 3u);
+  int progress_events = 0, mesh_events = 0;
+  for (size_t i = 0; i + 1 < events.size(); ++i) {
+    ASSERT_EQ(events[i].type, "job") << i;
+    const auto event = parse<v1::JobEvent>(events[i].data);
+    EXPECT_EQ(event.job_id(), job_id);
+    if (event.has_progress()) ++progress_events;
+    if (event.has_mesh()) {
+      // Connectivity comes once, in the first mesh event; positions every time, as JSON numbers.
+      EXPECT_EQ(event.mesh().triangles_size() > 0, mesh_events == 0) << "mesh event " << mesh_events;
+      EXPECT_EQ(event.mesh().positions_mm_size(), 3 * sphere.vertex_count());
+      ++mesh_events;
+    }
+  }
+  EXPECT_GE(progress_events, 2) << body.substr(0, 3000);
+  EXPECT_GE(mesh_events, 1);
+  EXPECT_EQ(parse<v1::JobEvent>(events[events.size() - 2].data).state(), v1::JOB_STATE_COMPLETED);
+  EXPECT_EQ(events.back().type, "end");
+  EXPECT_EQ(events.back().data, R"({"code":"OK","message":""})");
+
+  auto result = client->Get("/api/v1/jobs/" + job_id + "/result?format=MESH_FORMAT_OBJ");
+  ASSERT_TRUE(result);
+  ASSERT_EQ(result->status, 200);
+  const auto job_result = parse<v1::JobResult>(result->body);  // bytes came as base64
+  EXPECT_EQ(job_result.kind(), v1::JOB_KIND_SIMULATE);
+  EXPECT_TRUE(job_result.converged());
+  EXPECT_NE(job_result.report_json().find("pressure_kpa"), std::string::npos);
+
+  for (const char* name : {"rest.obj", "inflated.obj"}) {
+    auto file = client->Get("/api/v1/jobs/" + job_id + "/files/" + name);
+    ASSERT_TRUE(file);
+    ASSERT_EQ(file->status, 200) << name << ": " << file->body;
+    EXPECT_EQ(file->get_header_value("Content-Disposition"), std::string("attachment; filename=\"") + name + "\"");
+    const Result<TriMesh> mesh = read_mesh_from_memory(file->body, "obj");
+    ASSERT_TRUE(mesh.ok()) << name << ": " << mesh.error();
+    EXPECT_EQ(mesh->vertex_count(), sphere.vertex_count()) << name;
+    EXPECT_EQ(file->body, std::string(name) == "rest.obj" ? job_result.rest_mesh().data() : job_result.inflated_mesh().data());
+  }
+  auto report = client->Get("/api/v1/jobs/" + job_id + "/files/report.json");
+  ASSERT_TRUE(report);
+  EXPECT_EQ(report->body, job_result.report_json());
+  for (const char* name : {"mold.stl", "fit.svg", "secrets.txt"}) {
+    auto missing = client->Get("/api/v1/jobs/" + job_id + "/files/" + name);
+    ASSERT_TRUE(missing);
+    EXPECT_EQ(missing->status, 404) << name;
+    EXPECT_EQ(error_of(missing).first, "NOT_FOUND") << name;
+  }
+  // The job list shows it, filtered by state.
+  auto listed = client->Get("/api/v1/jobs?state=JOB_STATE_COMPLETED&page_size=10");
+  ASSERT_TRUE(listed);
+  ASSERT_EQ(listed->status, 200) << listed->body;
+  const auto jobs = parse<v1::ListJobsResponse>(listed->body);
+  ASSERT_EQ(jobs.jobs_size(), 1);
+  EXPECT_EQ(jobs.jobs(0).id(), job_id);
+  auto none = client->Get("/api/v1/jobs?state=JOB_STATE_RUNNING");
+  ASSERT_TRUE(none);
+  EXPECT_EQ(parse<v1::ListJobsResponse>(none->body).jobs_size(), 0);
+}
+
+TEST(HttpGateway, DesignJobServesTheSameMoldTheCliBuilds) {
+  ScratchDir scratch;
+  HttpServer server(scratch, {"--quiet", "--workers", "1"});
+  auto client = server.client();
+  const std::string body = R"({"spec":{"design":{"target_mesh":{"data":")" + base64(sphere_obj(2)) +
+                           R"(","format":"MESH_FORMAT_OBJ"},"material":{"name":"latex"},"resolution":-1,)"
+                           R"("max_time_s":5}}})";
+  const std::string job_id = submit(*client, body);
+  ASSERT_FALSE(job_id.empty());
+  int status = 0;
+  const std::vector<SseEvent> events = watch(*client, job_id, &status);
+  ASSERT_EQ(status, 200);
+  ASSERT_GE(events.size(), 2u);
+  EXPECT_EQ(events.back().data, R"({"code":"OK","message":""})");
+  bool errors_reported = false;
+  for (const SseEvent& event : events)
+    if (event.type == "job" && parse<v1::JobEvent>(event.data).progress().avg_error_mm() >= 0.0 &&
+        parse<v1::JobEvent>(event.data).has_progress())
+      errors_reported = true;
+  EXPECT_TRUE(errors_reported) << "design progress carries the error for the page's plot";
+
+  auto rest = client->Get("/api/v1/jobs/" + job_id + "/files/rest.obj");
+  auto report = client->Get("/api/v1/jobs/" + job_id + "/files/report.json");
+  auto mold = client->Get("/api/v1/jobs/" + job_id + "/files/mold.stl");
+  ASSERT_TRUE(rest && report && mold);
+  ASSERT_EQ(mold->status, 200) << mold->body;
+  EXPECT_EQ(mold->get_header_value("Content-Type"), "model/stl");
+  const Result<TriMesh> rest_mesh = read_mesh_from_memory(rest->body, "obj");
+  ASSERT_TRUE(rest_mesh.ok()) << rest_mesh.error();
+  const Result<TriMesh> mold_mesh = read_mesh_from_memory(mold->body, "stl");
+  ASSERT_TRUE(mold_mesh.ok()) << mold_mesh.error();
+  EXPECT_GT(mold_mesh->face_count(), rest_mesh->face_count());  // the rest shape plus a tube
+  // Byte for byte what the CLI writes: the same function on the same stored data.
+  const Result<TriMesh> expected = jobs::mold_from_report(*rest_mesh, report->body);
+  ASSERT_TRUE(expected.ok()) << expected.error();
+  EXPECT_EQ(mold->body, write_mesh_to_memory(*expected, "stl"));
+}
+
+TEST(HttpGateway, FitJobServesTheSamePlotAsTheCli) {
+  ScratchDir scratch;
+  HttpServer server(scratch, {"--quiet", "--workers", "1"});
+  auto client = server.client();
+  std::ifstream in(std::string(BALLOON_TEST_DATA_DIR) + "/materials/treloar1944_et.csv", std::ios::binary);
+  std::ostringstream csv;
+  csv << in.rdbuf();
+  const std::string body = R"({"spec":{"fit_material":{"data":[{"csv":")" + base64(csv.str()) +
+                           R"(","test":"equibiaxial"}],"model":"hart-smith"}}})";
+  const std::string job_id = submit(*client, body);
+  ASSERT_FALSE(job_id.empty());
+  int status = 0;
+  const std::vector<SseEvent> events = watch(*client, job_id, &status);
+  ASSERT_EQ(status, 200);
+  ASSERT_FALSE(events.empty());
+  ASSERT_EQ(events.back().data, R"({"code":"OK","message":""})");
+
+  auto plot = client->Get("/api/v1/jobs/" + job_id + "/files/fit.svg");
+  auto report = client->Get("/api/v1/jobs/" + job_id + "/files/report.json");
+  ASSERT_TRUE(plot && report);
+  ASSERT_EQ(plot->status, 200) << plot->body;
+  EXPECT_EQ(plot->get_header_value("Content-Type"), "image/svg+xml");
+  EXPECT_EQ(plot->body.rfind("<svg", 0), 0u);
+  // What `balloon fit-material --plot` draws from the same report (with the service's label for the file).
+  std::vector<jobs::FitDataFile> files(1);
+  files[0].label = "data[0]";
+  files[0].csv_text = csv.str();
+  files[0].test = "equibiaxial";
+  const Result<jobs::FitInput> input = jobs::prepare_fit(files, "hart-smith");
+  ASSERT_TRUE(input.ok()) << input.error();
+  const Result<jobs::FitOutcome> outcome = jobs::fit_outcome_from_json(*input, report->body);
+  ASSERT_TRUE(outcome.ok()) << outcome.error();
+  EXPECT_EQ(plot->body, jobs::fit_plot_svg(*input, *outcome));
+  for (const char* name : {"rest.obj", "mold.stl"}) {
+    auto missing = client->Get("/api/v1/jobs/" + job_id + "/files/" + name);
+    ASSERT_TRUE(missing);
+    EXPECT_EQ(missing->status, 404) << name;
+  }
+}
+
+TEST(HttpGateway, ErrorsCarryTheServiceCodeAndMessage) {
+  ScratchDir scratch;
+  HttpServer server(scratch, {"--quiet", "--workers", "1", "--max-message-mb", "1"});
+  auto client = server.client();
+  auto stub = server.stub();
+
+  auto bad_json = client->Post("/api/v1/jobs", "{\"spec\": {", "application/json");
+  ASSERT_TRUE(bad_json);
+  EXPECT_EQ(bad_json->status, 400);
+  EXPECT_EQ(error_of(bad_json).first, "INVALID_ARGUMENT");
+  EXPECT_NE(error_of(bad_json).second.find("not valid JSON"), std::string::npos) << error_of(bad_json).second;
+  auto typo = client->Post("/api/v1/jobs", R"({"spec":{"simulate":{"thickness":1}}})", "application/json");
+  ASSERT_TRUE(typo);
+  EXPECT_EQ(typo->status, 400);
+  EXPECT_NE(error_of(typo).second.find("thickness"), std::string::npos) << error_of(typo).second;
+
+  // A bad mesh: the HTTP answer is the gRPC answer, code and message.
+  const std::string garbage = "\x01\x02garbage\xff";
+  auto bad_mesh = client->Post("/api/v1/jobs", simulate_body(garbage, R"("volume_ratio":2)"), "application/json");
+  ASSERT_TRUE(bad_mesh);
+  EXPECT_EQ(bad_mesh->status, 400);
+  v1::SubmitJobRequest request;
+  request.mutable_spec()->mutable_simulate()->mutable_rest_mesh()->set_data(garbage);
+  request.mutable_spec()->mutable_simulate()->mutable_rest_mesh()->set_format(v1::MESH_FORMAT_OBJ);
+  request.mutable_spec()->mutable_simulate()->mutable_material()->set_name("latex");
+  request.mutable_spec()->mutable_simulate()->set_thickness_mm(0.5);
+  request.mutable_spec()->mutable_simulate()->set_volume_ratio(2);
+  grpc::ClientContext context;
+  v1::SubmitJobResponse reply;
+  const grpc::Status direct = stub->SubmitJob(&context, request, &reply);
+  ASSERT_EQ(direct.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(error_of(bad_mesh).first, "INVALID_ARGUMENT");
+  EXPECT_EQ(error_of(bad_mesh).second, direct.error_message());
+
+  for (const char* path : {"/api/v1/jobs/j-0000000000000000", "/api/v1/jobs/j-0000000000000000/events",
+                           "/api/v1/jobs/j-0000000000000000/result", "/api/v1/nothing-here"}) {
+    auto missing = client->Get(path);
+    ASSERT_TRUE(missing) << path;
+    EXPECT_EQ(missing->status, 404) << path;
+    EXPECT_EQ(error_of(missing).first, "NOT_FOUND") << path;
+  }
+  auto bad_state = client->Get("/api/v1/jobs?state=RUNNING");
+  ASSERT_TRUE(bad_state);
+  EXPECT_EQ(bad_state->status, 400);
+
+  // Larger than --max-message-mb: 413 before the service sees it.
+  const std::string huge = simulate_body(std::string(1 << 20, '#'), R"("volume_ratio":2)");
+  auto too_big = client->Post("/api/v1/jobs", huge, "application/json");
+  ASSERT_TRUE(too_big);
+  EXPECT_EQ(too_big->status, 413);
+  EXPECT_EQ(error_of(too_big).first, "RESOURCE_EXHAUSTED");
+
+  // An unfinished job: its result is 409 with the service's message; cancelling it works.
+  auto long_client = server.client();
+  const std::string job_id = submit(*long_client, busy_job_body());
+  ASSERT_FALSE(job_id.empty());
+  auto early = client->Get("/api/v1/jobs/" + job_id + "/result");
+  ASSERT_TRUE(early);
+  EXPECT_EQ(early->status, 409);
+  EXPECT_EQ(error_of(early).first, "FAILED_PRECONDITION");
+  EXPECT_FALSE(error_of(early).second.empty());
+  auto early_file = client->Get("/api/v1/jobs/" + job_id + "/files/rest.obj");
+  ASSERT_TRUE(early_file);
+  EXPECT_EQ(early_file->status, 409);
+  auto cancelled = client->Post("/api/v1/jobs/" + job_id + "/cancel", "{}", "application/json");
+  ASSERT_TRUE(cancelled);
+  ASSERT_EQ(cancelled->status, 200) << cancelled->body;
+  EXPECT_EQ(parse<v1::Job>(cancelled->body).state(), v1::JOB_STATE_CANCELLED);
+  int status = 0;
+  const std::vector<SseEvent> events = watch(*client, job_id, &status);
+  ASSERT_EQ(status, 200);
+  ASSERT_FALSE(events.empty());
+  EXPECT_EQ(parse<v1::JobEvent>(events.front().data).state(), v1::JOB_STATE_CANCELLED);
+  EXPECT_EQ(events.back().type, "end");
+}
+
+TEST(HttpGateway, TokensAreRequiredAsForGrpc) {
+  ScratchDir scratch;
+  std::ofstream(scratch.file("tokens")) << "alice alice-token-0123456789\nbob bob-token-0123456789ab\n";
+  HttpServer server(scratch, {"--workers", "1", "--token-file", scratch.file("tokens")});
+  auto client = server.client();
+  const httplib::Headers alice = {{"Authorization", "Bearer alice-token-0123456789"}};
+  const httplib::Headers bob = {{"Authorization", "Bearer bob-token-0123456789ab"}};
+
+  auto anonymous = client->Get("/api/v1/materials");
+  ASSERT_TRUE(anonymous);
+  EXPECT_EQ(anonymous->status, 401);
+  EXPECT_EQ(error_of(anonymous).first, "UNAUTHENTICATED");
+  auto wrong = client->Get("/api/v1/materials", {{"Authorization", "Bearer not-a-token-0123456789"}});
+  ASSERT_TRUE(wrong);
+  EXPECT_EQ(wrong->status, 401);
+  auto garbled = client->Get("/api/v1/materials", {{"Authorization", "Bearer \x7f\x01"}});
+  ASSERT_TRUE(garbled);
+  EXPECT_EQ(garbled->status, 401);
+  auto allowed = client->Get("/api/v1/materials", alice);
+  ASSERT_TRUE(allowed);
+  EXPECT_EQ(allowed->status, 200);
+
+  const std::string job_id = submit(*client, simulate_body(sphere_obj(2), R"("volume_ratio":2)"), alice);
+  ASSERT_FALSE(job_id.empty());
+  int status = 0;
+  EXPECT_TRUE(watch(*client, job_id, &status).empty());
+  EXPECT_EQ(status, 401) << "an event stream without a token is refused before it opens";
+  watch(*client, job_id, &status, bob);
+  EXPECT_EQ(status, 404) << "another tenant's job does not exist for bob";
+  const std::vector<SseEvent> events = watch(*client, job_id, &status, alice);
+  EXPECT_EQ(status, 200);
+  ASSERT_FALSE(events.empty());
+  EXPECT_EQ(events.back().data, R"({"code":"OK","message":""})");
+  auto rest = client->Get("/api/v1/jobs/" + job_id + "/files/rest.obj", bob);
+  ASSERT_TRUE(rest);
+  EXPECT_EQ(rest->status, 404);
+  server.stop(SIGTERM);
+  EXPECT_EQ(server.log().find("alice-token"), std::string::npos) << "tokens must never be logged";
+}
+
+TEST(HttpGateway, ServesTheWebRootAndNothingOutsideIt) {
+  ScratchDir scratch;
+  const std::string root = scratch.file("www");
+  std::filesystem::create_directories(root + "/samples");
+  std::ofstream(root + "/index.html") << "<!doctype html><title>balloon</title>";
+  std::ofstream(root + "/app.js") << "console.log('hi');";
+  std::ofstream(root + "/samples/ball.obj") << "v 0 0 0\n";
+  std::ofstream(scratch.file("secret.txt")) << "top secret";
+  HttpServer server(scratch, {"--quiet", "--web-root", root});
+  EXPECT_NE(server.output().find("(web root " + root + ")"), std::string::npos) << server.output();
+  auto client = server.client();
+
+  auto index = client->Get("/");
+  ASSERT_TRUE(index);
+  EXPECT_EQ(index->status, 200);
+  EXPECT_EQ(index->body, "<!doctype html><title>balloon</title>");
+  EXPECT_EQ(index->get_header_value("Content-Type"), "text/html; charset=utf-8");
+  EXPECT_EQ(index->get_header_value("Cache-Control"), "no-cache");
+  auto script = client->Get("/app.js");
+  ASSERT_TRUE(script);
+  EXPECT_EQ(script->get_header_value("Content-Type"), "text/javascript; charset=utf-8");
+  auto sample = client->Get("/samples/ball.obj");
+  ASSERT_TRUE(sample);
+  EXPECT_EQ(sample->body, "v 0 0 0\n");
+  EXPECT_EQ(sample->get_header_value("Content-Type"), "model/obj");
+  auto missing = client->Get("/nope.css");
+  ASSERT_TRUE(missing);
+  EXPECT_EQ(missing->status, 404);
+
+  client->set_url_encode(false);  // send the paths exactly as written
+  for (const char* path : {"/../secret.txt", "/samples/../../secret.txt", "/%2e%2e/secret.txt", "/..%2fsecret.txt"}) {
+    auto escaped = client->Get(path);
+    ASSERT_TRUE(escaped) << path;
+    EXPECT_NE(escaped->status, 200) << path;
+    EXPECT_EQ(escaped->body.find("top secret"), std::string::npos) << path;
+  }
+
+  // Without a built page the API still works and / says what to do.
+  ScratchDir other;
+  HttpServer unbuilt(other, {"--quiet", "--web-root", other.file("no-such-dir")});
+  auto page = unbuilt.client()->Get("/");
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 404);
+  EXPECT_NE(page->body.find("not built"), std::string::npos) << page->body;
+  auto api = unbuilt.client()->Get("/api/v1/health");
+  ASSERT_TRUE(api);
+  EXPECT_EQ(api->status, 200);
+}
+
+// Each open stream holds one of the gateway's 16 threads. Browsers that drop streams on a quiet (queued)
+// job must give them back at once, or a few reloads would starve every other request.
+TEST(HttpGateway, AbandonedEventStreamsFreeTheirThreadsAndShutdownEndsStreams) {
+  ScratchDir scratch;
+  HttpServer server(scratch, {"--quiet", "--workers", "1"});
+  auto client = server.client();
+  const std::string busy = submit(*client, busy_job_body());
+  const std::string queued = submit(*client, simulate_body(sphere_obj(2), R"("volume_ratio":2)"));
+  ASSERT_FALSE(busy.empty());
+  ASSERT_FALSE(queued.empty());
+  // More tabs than threads: without the threads coming back, the 17th would wait for a keepalive (15 s).
+  const auto started = Clock::now();
+  for (int i = 0; i < 24; ++i) {
+    auto tab = server.client();
+    bool got_first = false;
+    tab->Get("/api/v1/jobs/" + queued + "/events", [&](const char* data, size_t length) {
+      got_first = std::string(data, length).find("event: job") != std::string::npos;
+      return !got_first;  // false: the client hangs up, like a closed tab
+    });
+    EXPECT_TRUE(got_first) << i;
+  }
+  auto health = client->Get("/api/v1/health");
+  ASSERT_TRUE(health) << "no worker thread left";
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - started).count(), 5.0);
+  auto state = client->Get("/api/v1/jobs/" + queued);
+  ASSERT_TRUE(state);
+  EXPECT_EQ(parse<v1::Job>(state->body).state(), v1::JOB_STATE_QUEUED) << "the stream test needs a quiet job";
+
+  // SIGTERM while a stream is open: it ends with `event: end` UNAVAILABLE and the server exits cleanly.
+  std::string body;
+  std::atomic<bool> streaming{false};
+  std::thread watcher([&] {
+    auto tab = server.client();
+    tab->Get("/api/v1/jobs/" + queued + "/events", [&](const char* data, size_t length) {
+      body.append(data, length);
+      streaming = true;
+      return true;
+    });
+  });
+  const auto deadline = Clock::now() + std::chrono::seconds(10);
+  while (!streaming && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  const auto stopping = Clock::now();
+  EXPECT_EQ(server.stop(SIGTERM), 0);
+  watcher.join();
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - stopping).count(), 5.0);
+  const std::vector<SseEvent> events = parse_sse(body);
+  ASSERT_FALSE(events.empty()) << body;
+  EXPECT_EQ(events.back().type, "end");
+  EXPECT_EQ(events.back().data, R"({"code":"UNAVAILABLE","message":"the server is shutting down"})");
+}
+
+TEST(HttpGateway, FlagsFollowTheLoopbackRuleAndAreDocumented) {
+  std::string output;
+  EXPECT_EQ(run_server({"--http", "0.0.0.0:0", "--db", ":memory:"}, &output), 2);
+  EXPECT_NE(output.find("--token-file"), std::string::npos) << output;
+  output.clear();
+  EXPECT_EQ(run_server({"--help"}, &output), 0);
+  EXPECT_NE(output.find("--http HOST:PORT"), std::string::npos) << output;
+  EXPECT_NE(output.find("--web-root DIR"), std::string::npos) << output;
+  output.clear();
+  EXPECT_EQ(run_server({"--listen", "127.0.0.1:0", "--db", ":memory:", "--http", "127.0.0.1:http"}, &output), 1);
+  EXPECT_NE(output.find("port 'http'"), std::string::npos) << output;
+}
+
+}  // namespace
+}  // namespace balloon::testing

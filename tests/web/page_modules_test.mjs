@@ -1,0 +1,126 @@
+// Unit tests of the page's DOM-free modules (client/web/src), run by node's test runner:
+//   node --test tests/web/page_modules_test.mjs
+// Needs client/web/node_modules (three, three-mesh-bvh), which the balloon_web build installs.
+import assert from 'node:assert/strict';
+import { test } from 'node:test';
+import { SseParser } from '../../client/web/src/sse_parser.js';
+import { parse_obj, write_obj } from '../../client/web/src/obj_parser.js';
+import { parse_off } from '../../client/web/src/off_parser.js';
+import { nice_upper_bound, ramp_color } from '../../client/web/src/color_map.js';
+import { design_field_for_message } from '../../client/web/src/field_errors.js';
+import { mesh_format_for } from '../../client/web/src/mesh_loader.js';
+import { ordered_params, param_label } from '../../client/web/src/material_params.js';
+import { SurfaceDistance } from '../../client/web/src/surface_distance.js';
+import { base64_from_bytes, bytes_from_base64 } from '../../client/web/src/api_client.js';
+
+test('SSE parser: events split across chunks, CRLF, comments and multi-line data', () => {
+  const parser = new SseParser();
+  const stream = ': keepalive\r\nevent: job\r\ndata: {"a":1}\r\n\r\nevent: end\ndata: line one\ndata: line two\n\n';
+  const events = [];
+  // Feed one character at a time: every boundary, including inside "\r\n", must be handled.
+  for (const character of stream) events.push(...parser.feed(character));
+  assert.equal(events.length, 2);
+  assert.equal(events[0].type, 'job');
+  assert.deepEqual(JSON.parse(events[0].data), { a: 1 });
+  assert.equal(events[1].type, 'end');
+  assert.equal(events[1].data, 'line one\nline two');
+});
+
+test('SSE parser: no event before its blank line, default type "message"', () => {
+  const parser = new SseParser();
+  assert.deepEqual(parser.feed('data: x\n'), []);
+  const events = parser.feed('\n');
+  assert.equal(events.length, 1);
+  assert.equal(events[0].type, 'message');
+  assert.equal(events[0].data, 'x');
+});
+
+test('OBJ: slashes, negative indices and polygons (fan), round trip through write_obj', () => {
+  const mesh = parse_obj('v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/1 4/1\nf -4 -2 -1\n');
+  assert.equal(mesh.positions.length, 12);
+  assert.deepEqual(Array.from(mesh.indices), [0, 1, 2, 0, 2, 3, 0, 2, 3]);
+  const again = parse_obj(write_obj(mesh.positions, mesh.indices));
+  assert.deepEqual(Array.from(again.positions), Array.from(mesh.positions));
+  assert.deepEqual(Array.from(again.indices), Array.from(mesh.indices));
+});
+
+test('OBJ: garbage, missing faces and bad indices are named', () => {
+  assert.throws(() => parse_obj('this is not a mesh\n'), /no vertices/);
+  assert.throws(() => parse_obj('v 0 0 0\nv 1 0 0\nv 0 1 0\n'), /no triangles/);
+  assert.throws(() => parse_obj('v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n'), /line 4: vertex 7 does not exist/);
+  assert.throws(() => parse_obj('v 0 zero 0\n'), /line 1: 'zero' is not a number/);
+});
+
+test('OFF: counts on the header line or the next, comments, quads', () => {
+  const text = 'OFF\n# a square\n4 1 0\n0 0 0\n2 0 0\n2 2 0\n0 2 0\n4 0 1 2 3\n';
+  const mesh = parse_off(text);
+  assert.equal(mesh.positions.length / 3, 4);
+  assert.deepEqual(Array.from(mesh.indices), [0, 1, 2, 0, 2, 3]);
+  const same_line = parse_off('OFF 3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 255 0 0\n');
+  assert.deepEqual(Array.from(same_line.indices), [0, 1, 2]);
+  assert.throws(() => parse_off('PLY\n'), /not an OFF file/);
+  assert.throws(() => parse_off('OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n'), /face 0 names vertex 5/);
+});
+
+test('mesh formats by extension', () => {
+  assert.equal(mesh_format_for('a/b/Bunny.OBJ'), 'MESH_FORMAT_OBJ');
+  assert.equal(mesh_format_for('x.glb'), 'MESH_FORMAT_GLB');
+  assert.equal(mesh_format_for('notes.txt'), null);
+});
+
+test('legend bounds are the next round number at or above the value; ramp ends are the key colours', () => {
+  assert.equal(nice_upper_bound(0.37), 0.4);
+  assert.equal(nice_upper_bound(1.0), 1);
+  assert.equal(nice_upper_bound(1.2), 1.5);
+  assert.equal(nice_upper_bound(5.71), 6);
+  assert.equal(nice_upper_bound(8.5), 10);
+  assert.equal(nice_upper_bound(0.0123), 0.015);
+  assert.equal(nice_upper_bound(0), 1);
+  assert.deepEqual(ramp_color(0), [0.267, 0.005, 0.329]);
+  assert.deepEqual(ramp_color(1), [0.993, 0.906, 0.144]);
+  assert.deepEqual(ramp_color(2), ramp_color(1));
+});
+
+test('material constants come in the usual order with their units', () => {
+  assert.deepEqual(ordered_params({ k2: 0.49, G: 0.18, k1: 3e-4 }).map(([name]) => name), ['G', 'k1', 'k2']);
+  assert.deepEqual(ordered_params({ C2: 0.02, C1: 0.18 }).map(([name]) => name), ['C1', 'C2']);
+  assert.equal(param_label('G'), 'G (MPa)');
+  assert.equal(param_label('k1'), 'k1 (dimensionless)');
+});
+
+test('service messages go to the field they name', () => {
+  assert.equal(design_field_for_message("target_mesh: cannot read obj mesh data: no triangles (no 'f' lines)"), 'target');
+  assert.equal(design_field_for_message('thickness must be a positive number of mm, got -1'), 'thickness');
+  assert.equal(design_field_for_message('resolution must be at least 50 vertices (or 0 to keep the target\'s), got 3'), 'resolution');
+  assert.equal(design_field_for_message('volume ratio must be a positive number, got 0'), 'volume-ratio');
+  assert.equal(design_field_for_message('material: unknown material "rubber"'), 'material');
+  assert.equal(design_field_for_message('max time must be a number of s >= 0 (0 means none), got -3'), 'max-time');
+  assert.equal(design_field_for_message('queue is full'), null);
+});
+
+test('point-to-surface distance: exact on a scaled cube, zero on its own vertices', () => {
+  // Unit cube [0,1]^3 as 12 triangles, scaled by 10 (file units -> mm) like a job's target.
+  const positions = new Float32Array([0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1]);
+  const indices = new Uint32Array([
+    0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4, 1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7,
+  ]);
+  const distance = new SurfaceDistance(positions, indices, 10);
+  const points = new Float32Array([
+    5, 5, 25,   // above the top face: 15 mm
+    5, 5, 5,    // centre: 5 mm to every face
+    13, 14, 10, // off an edge (x = 10, y = 10 at z = 10): hypot(3, 4) = 5 mm
+    10, 10, 10, // a vertex: 0
+  ]);
+  const result = distance.distances(points);
+  const expected = [15, 5, 5, 0];
+  for (let i = 0; i < expected.length; ++i) assert.ok(Math.abs(result[i] - expected[i]) < 1e-5, `point ${i}: ${result[i]} vs ${expected[i]}`);
+});
+
+test('base64 round trip of bytes, including large buffers', () => {
+  const bytes = new Uint8Array(200000);
+  for (let i = 0; i < bytes.length; ++i) bytes[i] = (i * 7919) % 256;
+  const back = bytes_from_base64(base64_from_bytes(bytes.buffer));
+  assert.equal(back.length, bytes.length);
+  assert.ok(back.every((value, i) => value === bytes[i]));
+  assert.equal(base64_from_bytes(new TextEncoder().encode('OFF\n').buffer), 'T0ZGCg==');
+});
