@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <sstream>
@@ -13,12 +14,24 @@
 
 namespace balloon::testing {
 
-ServerProcess::ServerProcess(const std::string& db_path, const std::vector<std::string>& extra_args) {
+namespace {
+
+/// True once `output` holds the whole line that starts at `marker`.
+bool has_line(const std::string& output, const std::string& marker) {
+  const auto at = output.find(marker);
+  return at != std::string::npos && output.find('\n', at) != std::string::npos;
+}
+
+}  // namespace
+
+ServerProcess::ServerProcess(const std::string& db_path, const std::vector<std::string>& extra_args, bool quiet) {
   m_log_path = db_path + ".server.log";
   int out_pipe[2];
   if (pipe(out_pipe) != 0) throw std::runtime_error("pipe failed");
-  std::vector<std::string> args = {BALLOON_SERVER_PATH, "--listen", "127.0.0.1:0", "--db", db_path, "--quiet"};
+  std::vector<std::string> args = {BALLOON_SERVER_PATH, "--listen", "127.0.0.1:0", "--db", db_path};
+  if (quiet) args.push_back("--quiet");
   args.insert(args.end(), extra_args.begin(), extra_args.end());
+  const bool with_http = std::find(args.begin(), args.end(), "--http") != args.end();
   m_pid = fork();
   if (m_pid < 0) throw std::runtime_error("fork failed");
   if (m_pid == 0) {
@@ -34,24 +47,25 @@ ServerProcess::ServerProcess(const std::string& db_path, const std::vector<std::
     _exit(127);
   }
   close(out_pipe[1]);
-  std::string output;
+  const std::string grpc_marker = "listening on 127.0.0.1:", http_marker = "http on 127.0.0.1:";
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-  while (output.find('\n') == std::string::npos && std::chrono::steady_clock::now() < deadline) {
+  while ((!has_line(m_output, grpc_marker) || (with_http && !has_line(m_output, http_marker))) &&
+         std::chrono::steady_clock::now() < deadline) {
     pollfd fd{out_pipe[0], POLLIN, 0};
     if (poll(&fd, 1, 200) <= 0) continue;
     char buffer[512];
     const ssize_t n = read(out_pipe[0], buffer, sizeof(buffer));
     if (n <= 0) break;
-    output.append(buffer, static_cast<std::size_t>(n));
+    m_output.append(buffer, static_cast<std::size_t>(n));
   }
   close(out_pipe[0]);
-  const std::string marker = "listening on 127.0.0.1:";
-  const auto at = output.find(marker);
-  if (at == std::string::npos) {
+  const auto grpc_at = m_output.find(grpc_marker), http_at = m_output.find(http_marker);
+  if (grpc_at == std::string::npos || (with_http && http_at == std::string::npos)) {
     stop(SIGKILL);
-    throw std::runtime_error("balloon-server did not start: " + output + log());
+    throw std::runtime_error("balloon-server did not start: " + m_output + log());
   }
-  m_port = std::stoi(output.substr(at + marker.size()));
+  m_port = std::stoi(m_output.substr(grpc_at + grpc_marker.size()));
+  if (with_http) m_http_port = std::stoi(m_output.substr(http_at + http_marker.size()));
 }
 
 ServerProcess::~ServerProcess() {

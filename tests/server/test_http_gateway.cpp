@@ -27,6 +27,8 @@
 #include "jobs/json_reader.hpp"
 #include "mesh/icosphere.hpp"
 #include "mesh/mesh_io.hpp"
+#include "scratch_dir.hpp"
+#include "server_process.hpp"
 
 // Last: httplib.h pulls in <resolv.h>, whose `_res` macro breaks Eigen's headers if they come after it.
 #include <httplib.h>
@@ -40,107 +42,25 @@ using Clock = std::chrono::steady_clock;
 // A server that answers early (413) and closes must fail the client's write, not kill the test process.
 const bool SIGPIPE_IGNORED = (signal(SIGPIPE, SIG_IGN), true);
 
-class ScratchDir {
+/// A balloon-server child with `--listen 127.0.0.1:0 --http 127.0.0.1:0` (quiet when `--quiet` is among
+/// the arguments), with HTTP clients to it.
+class HttpServer : public ServerProcess {
  public:
-  ScratchDir() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "balloon-http-XXXXXX").string();
-    if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    m_path = pattern;
-  }
-  ~ScratchDir() {
-    std::error_code ignored;
-    std::filesystem::remove_all(m_path, ignored);
-  }
-  std::string file(const std::string& name) const { return (m_path / name).string(); }
+  HttpServer(const ScratchDir& scratch, std::vector<std::string> extra_args)
+      : ServerProcess(scratch.file("jobs.db"), with_http(extra_args), /*quiet=*/false) {}
 
- private:
-  std::filesystem::path m_path;
-};
-
-/// A balloon-server child with `--listen 127.0.0.1:0 --http 127.0.0.1:0`; reads both ports from stdout.
-class HttpServer {
- public:
-  HttpServer(const ScratchDir& scratch, const std::vector<std::string>& extra_args) {
-    m_log_path = scratch.file("server.log");
-    int out_pipe[2];
-    if (pipe(out_pipe) != 0) throw std::runtime_error("pipe failed");
-    std::vector<std::string> args = {BALLOON_SERVER_PATH, "--listen", "127.0.0.1:0", "--db", scratch.file("jobs.db"),
-                                     "--http", "127.0.0.1:0"};
-    args.insert(args.end(), extra_args.begin(), extra_args.end());
-    m_pid = fork();
-    if (m_pid < 0) throw std::runtime_error("fork failed");
-    if (m_pid == 0) {
-      dup2(out_pipe[1], STDOUT_FILENO);
-      const int log_fd = open(m_log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-      if (log_fd >= 0) dup2(log_fd, STDERR_FILENO);
-      close(out_pipe[0]);
-      close(out_pipe[1]);
-      std::vector<char*> argv;
-      for (std::string& arg : args) argv.push_back(arg.data());
-      argv.push_back(nullptr);
-      execv(argv[0], argv.data());
-      _exit(127);
-    }
-    close(out_pipe[1]);
-    const auto deadline = Clock::now() + std::chrono::seconds(20);
-    while (m_output.find("http on") == std::string::npos || m_output.find('\n', m_output.find("http on")) == std::string::npos) {
-      if (Clock::now() > deadline) break;
-      pollfd fd{out_pipe[0], POLLIN, 0};
-      if (poll(&fd, 1, 200) <= 0) continue;
-      char buffer[512];
-      const ssize_t n = read(out_pipe[0], buffer, sizeof(buffer));
-      if (n <= 0) break;
-      m_output.append(buffer, static_cast<std::size_t>(n));
-    }
-    close(out_pipe[0]);
-    const std::string grpc_marker = "listening on 127.0.0.1:", http_marker = "http on 127.0.0.1:";
-    const auto grpc_at = m_output.find(grpc_marker), http_at = m_output.find(http_marker);
-    if (grpc_at == std::string::npos || http_at == std::string::npos) {
-      stop(SIGKILL);
-      throw std::runtime_error("balloon-server did not start: " + m_output + log());
-    }
-    m_grpc_port = std::stoi(m_output.substr(grpc_at + grpc_marker.size()));
-    m_http_port = std::stoi(m_output.substr(http_at + http_marker.size()));
-  }
-  ~HttpServer() {
-    if (m_pid > 0) stop(SIGTERM);
-  }
-
-  int http_port() const { return m_http_port; }
-  const std::string& output() const { return m_output; }
   /// A fresh HTTP client (a browser tab).
   std::unique_ptr<httplib::Client> client() const {
-    auto client = std::make_unique<httplib::Client>("127.0.0.1", m_http_port);
+    auto client = std::make_unique<httplib::Client>("127.0.0.1", http_port());
     client->set_read_timeout(30, 0);
     return client;
   }
-  std::unique_ptr<v1::BalloonService::Stub> stub() const {
-    grpc::ChannelArguments arguments;
-    arguments.SetMaxReceiveMessageSize(-1);
-    return v1::BalloonService::NewStub(grpc::CreateCustomChannel(
-        "127.0.0.1:" + std::to_string(m_grpc_port), grpc::InsecureChannelCredentials(), arguments));
-  }
-  int stop(int signal) {
-    if (m_pid <= 0) return -1;
-    kill(m_pid, signal);
-    int status = 0;
-    waitpid(m_pid, &status, 0);
-    m_pid = -1;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  }
-  std::string log() const {
-    std::ifstream in(m_log_path);
-    std::ostringstream text;
-    text << in.rdbuf();
-    return text.str();
-  }
 
  private:
-  pid_t m_pid = -1;
-  int m_grpc_port = 0;
-  int m_http_port = 0;
-  std::string m_output;
-  std::string m_log_path;
+  static std::vector<std::string> with_http(std::vector<std::string> args) {
+    args.insert(args.begin(), {"--http", "127.0.0.1:0"});
+    return args;
+  }
 };
 
 /// Runs balloon-server with `args` to its exit; returns the exit code and fills `output` (stdout + stderr).

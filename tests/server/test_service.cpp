@@ -16,29 +16,13 @@
 #include "mesh/mesh_checks.hpp"
 #include "mesh/mesh_io.hpp"
 #include "server_process.hpp"
+#include "scratch_dir.hpp"
 
 namespace balloon::testing {
 namespace {
 
 namespace v1 = balloon::v1;
 using Clock = std::chrono::steady_clock;
-
-class ScratchDir {
- public:
-  ScratchDir() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "balloon-svc-XXXXXX").string();
-    if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    m_path = pattern;
-  }
-  ~ScratchDir() {
-    std::error_code ignored;
-    std::filesystem::remove_all(m_path, ignored);
-  }
-  std::string file(const std::string& name) const { return (m_path / name).string(); }
-
- private:
-  std::filesystem::path m_path;
-};
 
 std::string sphere_obj(int subdivisions, double radius_mm = 10.0) {
   return write_mesh_to_memory(make_icosphere(radius_mm, subdivisions), "obj");

@@ -14,28 +14,12 @@
 #include "mesh/mesh_checks.hpp"
 #include "mesh/mesh_io.hpp"
 #include "server_process.hpp"
+#include "scratch_dir.hpp"
 
 namespace balloon::testing {
 namespace {
 
 namespace v1 = balloon::v1;
-
-class JobsScratchDir {
- public:
-  JobsScratchDir() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "balloon-svcjobs-XXXXXX").string();
-    if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    m_path = pattern;
-  }
-  ~JobsScratchDir() {
-    std::error_code ignored;
-    std::filesystem::remove_all(m_path, ignored);
-  }
-  std::string file(const std::string& name) const { return (m_path / name).string(); }
-
- private:
-  std::filesystem::path m_path;
-};
 
 std::string read_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -84,7 +68,7 @@ std::vector<v1::JobEvent> watch_to_end(v1::BalloonService::Stub& stub, const std
 }
 
 TEST(ServiceJobs, FitJobFitsTreloarStoresTheMaterialAndReturnsTheReport) {
-  JobsScratchDir scratch;
+  ScratchDir scratch;
   ServerProcess server(scratch.file("jobs.db"), {"--workers", "1"});
   auto stub = server.stub();
 
@@ -158,7 +142,7 @@ TEST(ServiceJobs, FitReportReadsBackToTheSameTextPlotAndJson) {
 }
 
 TEST(ServiceJobs, BadFitJobsAreRefusedAtSubmitAndPresetsCannotBeOverwritten) {
-  JobsScratchDir scratch;
+  ScratchDir scratch;
   ServerProcess server(scratch.file("jobs.db"), {"--workers", "1"});
   auto stub = server.stub();
   std::string job_id;
@@ -191,7 +175,7 @@ TEST(ServiceJobs, BadFitJobsAreRefusedAtSubmitAndPresetsCannotBeOverwritten) {
 }
 
 TEST(ServiceJobs, DesignJobStreamsIntermediateMeshesAndReturnsAReport) {
-  JobsScratchDir scratch;
+  ScratchDir scratch;
   ServerProcess server(scratch.file("jobs.db"), {"--workers", "1"});
   auto stub = server.stub();
 
