@@ -41,15 +41,29 @@ constexpr double COPLANAR_HINGE_RAD = 1e-3;
 /// Rest-bending stiffness relative to E_dist's k_bending: enough to fix the null space of flat regions,
 /// small enough not to pull the design away from the target.
 constexpr double REST_BENDING_WEIGHT = 1e-2;
-/// The adjoint method stops when the average surface error (what the maker sees) has not improved by
-/// STALL_IMPROVEMENT (relative) in STALL_ITERATIONS iterations, even while E_dist still creeps down.
+/// The adjoint method stops when neither the average surface error (what the maker sees) nor the
+/// objective has improved by STALL_IMPROVEMENT (relative) in STALL_ITERATIONS iterations, or when the
+/// average error is below MATCH_TOLERANCE_REL of the target's diagonal (0.01 mm on 100 mm, far below
+/// what a 3D printer or a brushed silicone layer reproduces).
 constexpr double STALL_IMPROVEMENT = 0.01;
 constexpr int STALL_ITERATIONS = 15;
+constexpr double MATCH_TOLERANCE_REL = 1e-4;
+/// A stalled design whose inflated shape is further than this (relative to the diagonal, on average)
+/// from its rigid placement on the target is re-placed and continues.
+constexpr double REALIGN_TOLERANCE_REL = 1e-4;
 /// Newton steps a line-search trial may take before the step is halved instead.
 constexpr int TRIAL_NEWTON_ITERATIONS = 10;
 
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+/// A fraction as a short human string: 0.01 -> "1%", 1e-4 -> "1e-04".
+std::string format_fraction(double fraction) {
+  char text[32];
+  if (fraction >= 0.01) std::snprintf(text, sizeof(text), "%g%%", 100.0 * fraction);
+  else std::snprintf(text, sizeof(text), "%.0e", fraction);
+  return text;
 }
 
 Positions scaled_about_centroid(const Positions& points, double scale) {
@@ -93,6 +107,8 @@ class AdjointDesign {
     // vertices (a null space of the rest-shape Hessian); only then does the rest-bending term (the
     // bending part of eq. 18 against the start) take part.
     m_rest_bending_active = (m_start_hinges.rest_angles().array().abs() < COPLANAR_HINGE_RAD).any();
+    const double diag = m_surface.bbox_diagonal_mm();
+    m_surface_weight = options.k_surface * m_distance.rest_lengths().sum() / (diag * diag * target.vertex_count());
   }
 
   DesignResult run() {
@@ -140,12 +156,14 @@ class AdjointDesign {
     };
     auto lagrangian = [&](const Eigen::VectorXd& zz, Eigen::VectorXd* gradient) {
       const Eigen::VectorXd c = constraints(zz);
-      const double value =
-          m_distance.value(zz.tail(n)) + regularizer_value(zz.head(n)) - lambda.dot(c) + 0.5 * mu * c.squaredNorm();
+      Eigen::VectorXd surface_gradient;
+      const double value = m_distance.value(zz.tail(n)) + surface_term(zz.tail(n), gradient ? &surface_gradient : nullptr) +
+                           regularizer_value(zz.head(n)) - lambda.dot(c) + 0.5 * mu * c.squaredNorm();
       if (gradient) {
         const Eigen::VectorXd w = mu * c - lambda;
         Eigen::VectorXd distance_gradient;
         m_distance.gradient(zz.tail(n), distance_gradient);
+        distance_gradient += surface_gradient;
         gradient->resize(2 * n);
         gradient->head(n) = rest_force_transpose(zz.head(n), zz.tail(n), w);
         Eigen::VectorXd rest_part = gradient->head(n);
@@ -307,6 +325,7 @@ class AdjointDesign {
     m_distance.hessian_triplets(z.tail(n), objective_entries, DistanceHessian::GaussNewton, static_cast<int>(n));
     if (m_rest_bending_active)
       m_start_hinges.hessian_triplets(z.head(n), objective_entries, DistanceHessian::GaussNewton, 0);
+    add_surface_hessian(z.tail(n), objective_entries, static_cast<int>(n));
     std::vector<Eigen::Triplet<double>> kept;
     kept.reserve(objective_entries.size());
     for (const auto& entry : objective_entries)
@@ -369,6 +388,7 @@ class AdjointDesign {
     std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> memory;  // (s, y) pairs for L-BFGS
     int small_decreases = 0;
     double stall_reference = baseline.avg_mm;  // best surface error at the last real improvement (mm)
+    double stall_objective = objective;         // objective at the last real improvement of either
     int stall_iteration = 0;
     const double max_radius = 0.02 * result.bbox_diag_mm;  // mm
     double radius = max_radius;
@@ -446,7 +466,7 @@ class AdjointDesign {
         result.active_terms.push_back("collision");
       }
       Eigen::VectorXd new_gradient;
-      objective = objective_value(rest, m_x);
+        objective = objective_value(rest, m_x);
       if (!objective_gradient(rest, new_gradient)) {
         result.message = "the adjoint system could not be factorized";
         break;
@@ -470,13 +490,35 @@ class AdjointDesign {
         result.message = "converged";
         break;
       }
+      if (stats.avg_rel < MATCH_TOLERANCE_REL) {
+        result.converged = true;
+        result.message = "converged: the inflated shape matches the target to " + format_fraction(MATCH_TOLERANCE_REL) +
+                         " of its bounding-box diagonal";
+        break;
+      }
       if (stats.avg_mm < (1.0 - STALL_IMPROVEMENT) * stall_reference) {
         stall_reference = stats.avg_mm;
         stall_iteration = iteration;
+        stall_objective = objective;
+      } else if (objective < (1.0 - STALL_IMPROVEMENT) * stall_objective) {
+        stall_iteration = iteration;  // the error may rise for a while as the objective reshapes the balloon
+        stall_objective = objective;
+      } else if (iteration - stall_iteration >= STALL_ITERATIONS && realign_inflated_shape(result.bbox_diag_mm)) {
+        // The pinned coordinates held the shape where the start put it; re-placed on the target, the
+        // surface term can pull again. A rigid motion of an equilibrium is one: only the gauge changed.
+        memory.clear();
+        stall_iteration = iteration;
+        objective = objective_value(rest, m_x);
+        stall_objective = objective;
+        if (!objective_gradient(rest, gradient)) {
+          result.message = "the adjoint system could not be factorized";
+          break;
+        }
       } else if (iteration - stall_iteration >= STALL_ITERATIONS) {
         result.converged = true;
-        result.message = "converged: the surface error improved less than " + std::to_string(static_cast<int>(std::lround(100 * STALL_IMPROVEMENT))) +
-                         "% in the last " + std::to_string(STALL_ITERATIONS) + " iterations";
+        result.message = "converged: the surface error and the objective improved less than " +
+                         format_fraction(STALL_IMPROVEMENT) + " in the last " + std::to_string(STALL_ITERATIONS) +
+                         " iterations";
         break;
       }
     }
@@ -609,13 +651,70 @@ class AdjointDesign {
       }
       step *= 0.5;
     }
-    m_x = x;
+    // Place the inflated start on the target (a rigid motion of an equilibrium is one): the pinned
+    // coordinates then hold it in the target's frame, where E_surf and the errors are measured. A
+    // perturbed or user-given start need not inflate in place.
+    m_x = flat(rigid_align_to(unflatten(x), m_target.vertices));
     m_pressure = pressure;
     return true;
   }
 
   double objective_value(const Eigen::VectorXd& rest, const Eigen::VectorXd& x) const {
-    return m_distance.value(x) + regularizer_value(rest);
+    return m_distance.value(x) + surface_term(x, nullptr) + regularizer_value(rest);
+  }
+
+  /// E_surf = k_s L mean_i (d_i / diag)^2: the squared point-to-surface distances of the inflated
+  /// vertices (the error the result reports), scaled like E_dist per mm of reference edge (L = total
+  /// reference edge length, mm). Its gradient is 2 w (x_i - c_i) with c_i the closest target point
+  /// (the derivative of a squared distance to a surface, wherever the closest point is unique).
+  double surface_term(const Eigen::VectorXd& x, Eigen::VectorXd* gradient) const {
+    if (m_surface_weight <= 0.0) {
+      if (gradient) gradient->setZero(x.size());
+      return 0.0;
+    }
+    // x is in the target's frame: the start's inflation is aligned onto the target, and the 6 pinned
+    // coordinates keep it there.
+    const Positions points = unflatten(x);
+    Positions closest;
+    Eigen::VectorXd distances;
+    m_surface.closest_points(points, closest, &distances);
+    if (gradient) *gradient = 2.0 * m_surface_weight * flat(Positions(points - closest));
+    return m_surface_weight * distances.squaredNorm();
+  }
+
+  /// Moves the inflated shape rigidly onto the target (vertex correspondence) when that moves it by
+  /// more than REALIGN_TOLERANCE_REL of the diagonal on average, and says whether it did. Only E_surf
+  /// cares where the shape sits; the pinned coordinates otherwise keep the start's placement.
+  bool realign_inflated_shape(double bbox_diag_mm) {
+    if (m_surface_weight <= 0.0) return false;
+    const Positions current = unflatten(m_x);
+    const Positions aligned = rigid_align_to(current, m_target.vertices);
+    if ((aligned - current).rowwise().norm().mean() <= REALIGN_TOLERANCE_REL * bbox_diag_mm) return false;
+    m_x = flat(aligned);
+    return true;
+  }
+
+  /// Gauss-Newton Hessian of E_surf, point-to-plane: 2 w n n^T per vertex with n the normal of the
+  /// target triangle closest to it (sliding along the target costs nothing; E_dist governs that).
+  void add_surface_hessian(const Eigen::VectorXd& x, std::vector<Eigen::Triplet<double>>& triplets,
+                           int dof_offset) const {
+    if (m_surface_weight <= 0.0) return;
+    const Positions points = unflatten(x);
+    Positions closest;
+    Eigen::VectorXi faces;
+    m_surface.closest_points(points, closest, nullptr, &faces);
+    for (Eigen::Index v = 0; v < points.rows(); ++v) {
+      const Eigen::Vector3d a = m_target.vertices.row(m_target.faces(faces[v], 0));
+      const Eigen::Vector3d b = m_target.vertices.row(m_target.faces(faces[v], 1));
+      const Eigen::Vector3d c = m_target.vertices.row(m_target.faces(faces[v], 2));
+      const Eigen::Vector3d normal = (b - a).cross(c - a).normalized();
+      if (!normal.allFinite()) continue;
+      const Eigen::Matrix3d block = 2.0 * m_surface_weight * normal * normal.transpose();
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          triplets.emplace_back(dof_offset + 3 * static_cast<int>(v) + i, dof_offset + 3 * static_cast<int>(v) + j,
+                                block(i, j));
+    }
   }
 
   /// The rest-shape terms that are active: collisions, rest bending, maximum volume.
@@ -644,6 +743,7 @@ class AdjointDesign {
   /// Active terms every method shares (the method adds its own).
   void list_common_terms(DesignResult& result) const {
     result.active_terms.push_back("distance");
+    if (m_surface_weight > 0.0) result.active_terms.push_back("surface");
     if (!m_options.nozzle_vertices.empty()) result.active_terms.push_back("nozzle");
     if (m_rest_bending_active) result.active_terms.push_back("rest_bending");
   }
@@ -655,6 +755,9 @@ class AdjointDesign {
     if (!m_solver.factorize_exact(m_x, m_pressure)) return false;
     Eigen::VectorXd distance_gradient;
     m_distance.gradient(m_x, distance_gradient);
+    Eigen::VectorXd surface_gradient;
+    surface_term(m_x, &surface_gradient);
+    distance_gradient += surface_gradient;
     const Eigen::VectorXd v = m_model.volume_gradient(m_x);
     const Eigen::VectorXd a = m_solver.solve_with_factorization(distance_gradient);
     const Eigen::VectorXd b = m_solver.solve_with_factorization(v);
@@ -730,7 +833,11 @@ class AdjointDesign {
   /// factorized once. The rest-to-inflated map is close to a scaling, so this is the shape of the
   /// objective's curvature in rest coordinates; L-BFGS corrects the rest.
   void build_preconditioner() {
-    Eigen::SparseMatrix<double> hessian = m_distance.hessian(m_x, DistanceHessian::GaussNewton);
+    std::vector<Eigen::Triplet<double>> entries;
+    m_distance.hessian_triplets(m_x, entries, DistanceHessian::GaussNewton);
+    add_surface_hessian(m_x, entries, 0);
+    Eigen::SparseMatrix<double> hessian(m_x.size(), m_x.size());
+    hessian.setFromTriplets(entries.begin(), entries.end());
     const double shift = 1e-3 * hessian.diagonal().mean();
     for (int c = 0; c < hessian.rows(); ++c) hessian.coeffRef(c, c) += shift;
     m_preconditioner = std::make_unique<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>>>(hessian);
@@ -822,6 +929,7 @@ class AdjointDesign {
   bool m_collision_seen = false;
   DistanceEnergy m_start_hinges;  ///< the start's hinge angles; with k_length 0 it is the rest-bending term
   bool m_rest_bending_active = false;
+  double m_surface_weight = 0.0;  ///< w of E_surf = w sum_i d_i^2 (mm^-1); 0 when k_surface is 0
   double m_max_volume_weight = 0.0;  ///< alm: weight of -V(rest) once a region turned inside out (mm^-2)
   double m_target_volume;
   std::vector<bool> m_rest_free;
@@ -844,6 +952,9 @@ std::string options_problem(const TriMesh& target, const DesignOptions& options)
     return "volume ratio must be a number above 1";
   }
   if (!(enclosed_volume(target.vertices, target.faces) > 0.0)) return "the target encloses no positive volume";
+  if (!(options.k_length >= 0.0 && options.k_bending >= 0.0 && options.k_surface >= 0.0) ||
+      !std::isfinite(options.k_length + options.k_bending + options.k_surface))
+    return "the objective's weights must be finite and not negative";
   if (options.initial_rest.rows() != 0) {
     if (options.initial_rest.rows() != target.vertex_count() || !options.initial_rest.allFinite())
       return "the initial rest shape must have one finite position per target vertex";

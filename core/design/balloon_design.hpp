@@ -33,6 +33,11 @@ struct DesignOptions {
   double max_time_s = 0.0;              ///< wall-time budget (s); 0 = none
   int max_iterations = 200;             ///< outer iterations
   double k_length = 1.0, k_bending = 1.0;  ///< E_dist coefficients (eq. 18)
+  /// Weight of the surface term k_s L mean_i (d_i / diag)^2 (d_i: inflated vertex to target surface,
+  /// mm; L: total target edge length, mm): with 100, a surface distance of 10% of the diagonal costs as
+  /// much as a 100% edge strain. It targets the error the result reports, which E_dist alone trades
+  /// against hinge angles (bench: bunny 2.4x -> 3.5x better than the baseline). 0 switches it off.
+  double k_surface = 100.0;
   int progress_mesh_every = 5;          ///< attach the inflated mesh to every K-th progress event
   ProgressCallback progress;            ///< optional; phases "start", "design"
   const CancelToken* cancel = nullptr;  ///< optional; checked between iterations
@@ -63,7 +68,8 @@ struct DesignResult {
   double baseline_avg_error_mm = 0.0, baseline_max_error_mm = 0.0;  ///< the start (downscaled target) inflated
   double distance_energy = 0.0;        ///< E_dist at the end (mm)
   double residual_norm = 0.0;          ///< force residual of the inflated shape (N)
-  /// The objective's terms and constraints that took part: "distance" always; "fixed_rest_volume"
+  /// The objective's terms and constraints that took part: "distance" always; "surface" (k_surface > 0);
+  /// "fixed_rest_volume"
   /// (adjoint: the rest volume is held at target volume / ratio); "max_volume" (alm, once a rest region
   /// has turned inside out); "rest_bending" (the start has coplanar hinges); "collision" (rest vertices
   /// came within the contact distance); "nozzle" (nozzle vertices held).
