@@ -293,12 +293,9 @@ class AdjointDesign {
     const Faces& faces = m_target.faces;
     std::vector<Eigen::Triplet<double>> jacobian_entries;
     jacobian_entries.reserve(static_cast<size_t>(faces.rows()) * 162);
+    const Eigen::VectorXd rest = z.head(n), x = z.tail(n);
     for (int f = 0; f < faces.rows(); ++f) {
-      fem::Vector9d rest_corners, x_corners;
-      for (int k = 0; k < 3; ++k) {
-        rest_corners.segment<3>(3 * k) = z.segment<3>(3 * faces(f, k));
-        x_corners.segment<3>(3 * k) = z.segment<3>(n + 3 * faces(f, k));
-      }
+      const fem::Vector9d rest_corners = m_model.corners(rest, f), x_corners = m_model.corners(x, f);
       const fem::Matrix9d mixed =
           fem::membrane_mixed_derivative(m_options.material, m_options.thickness_mm, rest_corners, x_corners);
       double energy = 0.0;
@@ -338,23 +335,6 @@ class AdjointDesign {
     identity.setIdentity();
     hessian += 0.0 * identity;
     return hessian;
-  }
-
-  static Eigen::VectorXd plain_lbfgs(const std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>>& memory,
-                                     const Eigen::VectorXd& gradient) {
-    Eigen::VectorXd q = gradient;
-    std::vector<double> alpha(memory.size());
-    for (int i = static_cast<int>(memory.size()) - 1; i >= 0; --i) {
-      const auto& [s, y] = memory[static_cast<size_t>(i)];
-      alpha[static_cast<size_t>(i)] = s.dot(q) / y.dot(s);
-      q -= alpha[static_cast<size_t>(i)] * y;
-    }
-    if (!memory.empty()) q *= memory.back().first.dot(memory.back().second) / memory.back().second.squaredNorm();
-    for (size_t i = 0; i < memory.size(); ++i) {
-      const auto& [s, y] = memory[i];
-      q += (alpha[i] - y.dot(q) / y.dot(s)) * s;
-    }
-    return q;
   }
 
   DesignResult run_adjoint() {
@@ -778,45 +758,34 @@ class AdjointDesign {
     return gradient.allFinite();
   }
 
-  /// sum over triangles of (d grad_x W_e / d rest)^T w_e: how forces weighted by w change with the rest shape.
-  Eigen::VectorXd rest_force_transpose(const Eigen::VectorXd& rest, const Eigen::VectorXd& x,
-                                       const Eigen::VectorXd& w) const {
+  /// sum over triangles of M_e s_e, or of M_e^T s_e with `transpose`, M_e = d grad_x W_e / d rest the
+  /// element's mixed derivative (9x9) at (rest, x): how the forces change with the rest shape (M s), and
+  /// how forces weighted by s change with it (M^T s).
+  Eigen::VectorXd mixed_product(const Eigen::VectorXd& rest, const Eigen::VectorXd& x, const Eigen::VectorXd& s,
+                                bool transpose) const {
     Eigen::VectorXd out = Eigen::VectorXd::Zero(rest.size());
     const Faces& faces = m_target.faces;
     for (int f = 0; f < faces.rows(); ++f) {
-      fem::Vector9d rest_corners, x_corners, w_corners;
-      for (int k = 0; k < 3; ++k) {
-        rest_corners.segment<3>(3 * k) = rest.segment<3>(3 * faces(f, k));
-        x_corners.segment<3>(3 * k) = x.segment<3>(3 * faces(f, k));
-        w_corners.segment<3>(3 * k) = w.segment<3>(3 * faces(f, k));
-      }
-      const fem::Vector9d contribution =
-          fem::membrane_mixed_derivative(m_options.material, m_options.thickness_mm, rest_corners, x_corners)
-              .transpose() *
-          w_corners;
-      for (int k = 0; k < 3; ++k) out.segment<3>(3 * faces(f, k)) += contribution.segment<3>(3 * k);
+      const fem::Matrix9d mixed = fem::membrane_mixed_derivative(m_options.material, m_options.thickness_mm,
+                                                                 m_model.corners(rest, f), m_model.corners(x, f));
+      const fem::Vector9d corners = m_model.corners(s, f);
+      const fem::Vector9d product = transpose ? fem::Vector9d(mixed.transpose() * corners) : fem::Vector9d(mixed * corners);
+      for (int k = 0; k < 3; ++k) out.segment<3>(3 * faces(f, k)) += product.segment<3>(3 * k);
     }
     return out;
+  }
+
+  /// (d grad_x W / d rest)^T w: how forces weighted by w change with the rest shape.
+  Eigen::VectorXd rest_force_transpose(const Eigen::VectorXd& rest, const Eigen::VectorXd& x,
+                                       const Eigen::VectorXd& w) const {
+    return mixed_product(rest, x, w, true);
   }
 
   /// d(x, p) for a rest change `direction` at the current equilibrium, using the current factorization:
   /// [K -v; -v^T 0] [dx; dp] = [-(d grad_x W / d rest) direction; 0].
   void linear_response(const Eigen::VectorXd& rest, const Eigen::VectorXd& direction, Eigen::VectorXd& dx,
                        double& dp) const {
-    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(rest.size());
-    const Faces& faces = m_target.faces;
-    for (int f = 0; f < faces.rows(); ++f) {
-      fem::Vector9d rest_corners, x_corners, step_corners;
-      for (int k = 0; k < 3; ++k) {
-        rest_corners.segment<3>(3 * k) = rest.segment<3>(3 * faces(f, k));
-        x_corners.segment<3>(3 * k) = m_x.segment<3>(3 * faces(f, k));
-        step_corners.segment<3>(3 * k) = direction.segment<3>(3 * faces(f, k));
-      }
-      const fem::Vector9d change =
-          fem::membrane_mixed_derivative(m_options.material, m_options.thickness_mm, rest_corners, x_corners) *
-          step_corners;
-      for (int k = 0; k < 3; ++k) rhs.segment<3>(3 * faces(f, k)) -= change.segment<3>(3 * k);
-    }
+    const Eigen::VectorXd rhs = -mixed_product(rest, m_x, direction, false);
     const Eigen::VectorXd v = m_model.volume_gradient(m_x);
     const Eigen::VectorXd a = m_solver.solve_with_factorization(rhs);
     const Eigen::VectorXd b = m_solver.solve_with_factorization(v);
