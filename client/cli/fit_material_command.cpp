@@ -157,6 +157,7 @@ int run_fit_material_command(const std::vector<std::string>& args) {
     set->set_test(file.test);
     set->set_radius_mm(file.radius_mm);
     set->set_thickness_mm(file.thickness_mm);
+    set->set_label(file.label);
   }
   job->set_model(*parsed->get("model"));
   const std::optional<std::string> name = parsed->get("name");
@@ -200,7 +201,7 @@ int run_fit_material_command(const std::vector<std::string>& args) {
     job_request.set_job_id(job_id);
     if (!(*connection)->stub().GetJob(&job_context, job_request, &finished).ok()) finished.Clear();
   }
-  // The report carries every number; labels and tests come from the local input (the wire has no file names).
+  // The report carries every number; labels and tests come from the local input.
   Result<jobs::FitOutcome> outcome = jobs::fit_outcome_from_json(*input, result.report_json());
   if (!outcome) return report_error(command, "job " + job_id + ": " + outcome.error(), EXIT_INTERNAL);
   if (finished.finished_ms() > 0 && finished.started_ms() > 0)

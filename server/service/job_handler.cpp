@@ -185,14 +185,19 @@ static LoadedDesign load_design(const v1::DesignJob& job, const std::string& ten
   return loaded;
 }
 
-/// The proto measurement sets as the job layer's files; labels are "data[i]" (the wire carries no file names).
+/// The name a measurement set goes by: its label, or "data[i]" when the client sent none.
+static std::string measurement_label(const v1::FitMaterialJob& job, int i) {
+  return job.data(i).label().empty() ? "data[" + std::to_string(i) + "]" : job.data(i).label();
+}
+
+/// The proto measurement sets as the job layer's files.
 static std::vector<jobs::FitDataFile> fit_files(const v1::FitMaterialJob& job) {
   std::vector<jobs::FitDataFile> files;
   files.reserve(static_cast<size_t>(job.data_size()));
   for (int i = 0; i < job.data_size(); ++i) {
     const v1::MeasurementSet& set = job.data(i);
     jobs::FitDataFile file;
-    file.label = "data[" + std::to_string(i) + "]";
+    file.label = measurement_label(job, i);
     file.csv_text = set.csv();
     file.test = set.test();
     file.radius_mm = set.radius_mm();
@@ -794,7 +799,7 @@ void JobHandler::run_fit_job(const store::JobRecord& record, const v1::JobSpec& 
   std::string stored_note;
   if (!job.name().empty()) {
     std::vector<std::string> labels;
-    for (int i = 0; i < job.data_size(); ++i) labels.push_back("data[" + std::to_string(i) + "]");
+    for (int i = 0; i < job.data_size(); ++i) labels.push_back(measurement_label(job, i));
     v1::PutMaterialRequest put;
     put.mutable_material()->set_name(job.name());
     put.mutable_material()->set_spec(material_spec(best.material));

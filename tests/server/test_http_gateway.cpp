@@ -427,7 +427,7 @@ TEST(HttpGateway, FitJobServesTheSamePlotAsTheCli) {
   std::ostringstream csv;
   csv << in.rdbuf();
   const std::string body = R"({"spec":{"fit_material":{"data":[{"csv":")" + base64(csv.str()) +
-                           R"(","test":"equibiaxial"}],"model":"hart-smith"}}})";
+                           R"(","test":"equibiaxial","label":"sheet-a.csv"}],"model":"hart-smith"}}})";
   const std::string job_id = submit(*client, body);
   ASSERT_FALSE(job_id.empty());
   int status = 0;
@@ -442,9 +442,9 @@ TEST(HttpGateway, FitJobServesTheSamePlotAsTheCli) {
   ASSERT_EQ(plot->status, 200) << plot->body;
   EXPECT_EQ(plot->get_header_value("Content-Type"), "image/svg+xml");
   EXPECT_EQ(plot->body.rfind("<svg", 0), 0u);
-  // What `balloon fit-material --plot` draws from the same report (with the service's label for the file).
+  // What `balloon fit-material --plot` draws from the same report, with the label the request gave.
   std::vector<jobs::FitDataFile> files(1);
-  files[0].label = "data[0]";
+  files[0].label = "sheet-a.csv";
   files[0].csv_text = csv.str();
   files[0].test = "equibiaxial";
   const Result<jobs::FitInput> input = jobs::prepare_fit(files, "hart-smith");

@@ -53,7 +53,7 @@ export class FitPanel {
     }
     if (!ok) return;
 
-    const set = { csv: base64_from_bytes(await file.arrayBuffer()), test: elements.test.value };
+    const set = { csv: base64_from_bytes(await file.arrayBuffer()), test: elements.test.value, label: file.name };
     if (set.test === 'bulge') {
       set.radius_mm = Number(elements.radius.value);
       set.thickness_mm = Number(elements.thickness.value);
