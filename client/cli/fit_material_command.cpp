@@ -164,10 +164,8 @@ int run_fit_material_command(const std::vector<std::string>& args) {
   if (name) job->set_name(*name);
   std::string job_id;
   {
-    grpc::ClientContext context;
-    (*connection)->prepare(context);
     v1::SubmitJobResponse submitted;
-    const grpc::Status status = (*connection)->stub().SubmitJob(&context, request, &submitted);
+    const grpc::Status status = (*connection)->submit(request, &submitted);
     if (!status.ok()) {
       std::string message = status.error_message();
       if (status.error_code() == grpc::StatusCode::PERMISSION_DENIED && name) message = "--name " + *name + ": " + message;

@@ -115,10 +115,8 @@ int submit(const std::vector<std::string>& args) {
   options.run_jobs = false;
   auto connection = ServiceConnection::open(options);
   if (!connection) return report_error(command, connection.error(), EXIT_UNAVAILABLE);
-  grpc::ClientContext context;
-  (*connection)->prepare(context);
   v1::SubmitJobResponse reply;
-  const grpc::Status status = (*connection)->stub().SubmitJob(&context, *request, &reply);
+  const grpc::Status status = (*connection)->submit(*request, &reply);
   if (!status.ok()) return report_error(command, status.error_message(), exit_code_for(status));
   if (parsed->has("json"))
     std::cout << to_json(reply.job()) << std::endl;

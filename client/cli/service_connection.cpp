@@ -102,6 +102,18 @@ void ServiceConnection::prepare(grpc::ClientContext& context) const {
   if (!m_token.empty()) context.AddMetadata("authorization", "Bearer " + m_token);
 }
 
+grpc::Status ServiceConnection::submit(const balloon::v1::SubmitJobRequest& request,
+                                       balloon::v1::SubmitJobResponse* reply) {
+  grpc::ClientContext context;
+  prepare(context);
+  return m_stub->SubmitJob(&context, request, reply);
+}
+
+std::string message_naming_file(const grpc::Status& status, const std::string& field, const std::string& path) {
+  const std::string& message = status.error_message();
+  return message.rfind(field, 0) == 0 ? "'" + path + "': " + message : message;
+}
+
 int exit_code_for(const grpc::Status& status) {
   switch (status.error_code()) {
     case grpc::StatusCode::OK: return EXIT_OK;

@@ -47,6 +47,8 @@ class ServiceConnection {
   balloon::v1::BalloonService::Stub& stub() { return *m_stub; }
   /// Adds the token to a call's metadata.
   void prepare(grpc::ClientContext& context) const;
+  /// SubmitJob with the token: returns once the job is stored and queued.
+  grpc::Status submit(const balloon::v1::SubmitJobRequest& request, balloon::v1::SubmitJobResponse* reply);
   /// True for the embedded server.
   bool embedded() const { return m_embedded != nullptr; }
   /// Where the embedded server keeps its data (empty for a remote server).
@@ -63,5 +65,9 @@ class ServiceConnection {
 
 /// The CLI exit code for a failed call (exit_codes.hpp).
 int exit_code_for(const grpc::Status& status);
+
+/// The service's message for a failed call, naming the user's file where the message is about the
+/// request field that carried it: "target_mesh: no triangles" -> "'bunny.obj': target_mesh: no triangles".
+std::string message_naming_file(const grpc::Status& status, const std::string& field, const std::string& path);
 
 }  // namespace balloon::cli

@@ -119,16 +119,8 @@ int run_simulate_command(const std::vector<std::string>& args) {
   if (!connection) return report_error(COMMAND, connection.error(), EXIT_UNAVAILABLE);
 
   v1::SubmitJobResponse submitted;
-  {
-    grpc::ClientContext context;
-    (*connection)->prepare(context);
-    const grpc::Status status = (*connection)->stub().SubmitJob(&context, *request, &submitted);
-    if (!status.ok()) {
-      std::string message = status.error_message();
-      if (message.rfind("rest_mesh", 0) == 0) message = "'" + mesh_path + "': " + message;
-      return report_error(COMMAND, message, exit_code_for(status));
-    }
-  }
+  if (const grpc::Status status = (*connection)->submit(*request, &submitted); !status.ok())
+    return report_error(COMMAND, message_naming_file(status, "rest_mesh", mesh_path), exit_code_for(status));
   const std::string job_id = submitted.job().id();
 
   ProgressPrinter printer(isatty(STDERR_FILENO) == 1);

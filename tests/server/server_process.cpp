@@ -102,4 +102,19 @@ void add_token(grpc::ClientContext& context, const std::string& token) {
   if (!token.empty()) context.AddMetadata("authorization", "Bearer " + token);
 }
 
+std::vector<balloon::v1::JobEvent> watch_all(balloon::v1::BalloonService::Stub& stub, const std::string& job_id,
+                                             grpc::Status* status, const std::string& token) {
+  grpc::ClientContext context;
+  add_token(context, token);
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(90));
+  balloon::v1::WatchJobRequest request;
+  request.set_job_id(job_id);
+  auto reader = stub.WatchJob(&context, request);
+  std::vector<balloon::v1::JobEvent> events;
+  balloon::v1::JobEvent event;
+  while (reader->Read(&event)) events.push_back(event);
+  *status = reader->Finish();
+  return events;
+}
+
 }  // namespace balloon::testing

@@ -46,4 +46,8 @@ class ServerProcess {
 /// Adds `authorization: Bearer token` to a context (no-op for an empty token).
 void add_token(grpc::ClientContext& context, const std::string& token);
 
+/// Every event of WatchJob until the stream ends (at most 90 s), and the stream's final status.
+std::vector<balloon::v1::JobEvent> watch_all(balloon::v1::BalloonService::Stub& stub, const std::string& job_id,
+                                             grpc::Status* status, const std::string& token = "");
+
 }  // namespace balloon::testing

@@ -79,21 +79,6 @@ v1::Job wait_for(v1::BalloonService::Stub& stub, const std::string& job_id, v1::
   return job;
 }
 
-std::vector<v1::JobEvent> watch_all(v1::BalloonService::Stub& stub, const std::string& job_id, grpc::Status* status,
-                                    const std::string& token = "") {
-  grpc::ClientContext context;
-  add_token(context, token);
-  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(60));
-  v1::WatchJobRequest request;
-  request.set_job_id(job_id);
-  auto reader = stub.WatchJob(&context, request);
-  std::vector<v1::JobEvent> events;
-  v1::JobEvent event;
-  while (reader->Read(&event)) events.push_back(event);
-  *status = reader->Finish();
-  return events;
-}
-
 TEST(Service, SubmitWatchResultRoundTripStreamsDecodableIntermediateMeshes) {
   ScratchDir scratch;
   ServerProcess server(scratch.file("jobs.db"), {"--workers", "2"});

@@ -54,19 +54,6 @@ grpc::Status submit_job(v1::BalloonService::Stub& stub, const v1::SubmitJobReque
   return status;
 }
 
-std::vector<v1::JobEvent> watch_to_end(v1::BalloonService::Stub& stub, const std::string& job_id, grpc::Status* status) {
-  grpc::ClientContext context;
-  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(90));
-  v1::WatchJobRequest request;
-  request.set_job_id(job_id);
-  auto reader = stub.WatchJob(&context, request);
-  std::vector<v1::JobEvent> events;
-  v1::JobEvent event;
-  while (reader->Read(&event)) events.push_back(event);
-  *status = reader->Finish();
-  return events;
-}
-
 TEST(ServiceJobs, FitJobFitsTreloarStoresTheMaterialAndReturnsTheReport) {
   ScratchDir scratch;
   ServerProcess server(scratch.file("jobs.db"), {"--workers", "1"});
@@ -76,7 +63,7 @@ TEST(ServiceJobs, FitJobFitsTreloarStoresTheMaterialAndReturnsTheReport) {
   const grpc::Status submitted = submit_job(*stub, treloar_fit_request("hart-smith", "treloar-hs"), &job_id);
   ASSERT_TRUE(submitted.ok()) << submitted.error_message();
   grpc::Status status;
-  const std::vector<v1::JobEvent> events = watch_to_end(*stub, job_id, &status);
+  const std::vector<v1::JobEvent> events = watch_all(*stub, job_id, &status);
   ASSERT_TRUE(status.ok()) << status.error_message();
   ASSERT_FALSE(events.empty());
   ASSERT_EQ(events.back().state(), v1::JOB_STATE_COMPLETED) << events.back().message();
@@ -193,7 +180,7 @@ TEST(ServiceJobs, DesignJobStreamsIntermediateMeshesAndReturnsAReport) {
   ASSERT_TRUE(submitted.ok()) << submitted.error_message();
 
   grpc::Status status;
-  const std::vector<v1::JobEvent> events = watch_to_end(*stub, job_id, &status);
+  const std::vector<v1::JobEvent> events = watch_all(*stub, job_id, &status);
   ASSERT_TRUE(status.ok()) << status.error_message();
   ASSERT_FALSE(events.empty());
   ASSERT_EQ(events.back().state(), v1::JOB_STATE_COMPLETED) << events.back().message();
