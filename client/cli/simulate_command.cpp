@@ -39,8 +39,9 @@ constexpr const char* HELP =
     "  --json              print one JSON object on stdout instead of a summary\n"
     "  --help              this text\n\n"
     "JSON keys: converged, pressure_kpa, volume_mm3, rest_volume_mm3, volume_ratio, mean_stretch,\n"
-    "max_stretch, newton_iterations, factorizations, load_steps, residual_norm (N), time_s, vertices,\n"
-    "faces, material, material_name, thickness_mm, control, flipped_orientation, message.\n\n"
+    "max_stretch, newton_iterations, factorizations, load_steps, residual_norm (N), unstable_modes\n"
+    "(volume control: unstable directions of the equilibrium, 0 = stable), time_s, vertices, faces,\n"
+    "material, material_name, thickness_mm, control, flipped_orientation, message.\n\n"
     "Exit codes: 0 converged, 2 bad input (one line on stderr names it), 3 not converged (the result is\n"
     "still printed, no --out file), 5 server unreachable or busy, 6 not allowed, 8 the job failed,\n"
     "130 interrupted (the job is cancelled), 1 internal error.\n\n";
@@ -75,6 +76,9 @@ std::string summary_from_report(const std::string& report_json) {
       << number_field(report, "factorizations") << " factorizations) in " << format("%.3f", number_field(report, "time_s"))
       << " s\n";
   if (const std::string message = string_field(report, "message"); !message.empty()) out << "  " << message << "\n";
+  if (const double unstable = number_field(report, "unstable_modes"); unstable > 0)
+    out << "  stability      a saddle under volume control: " << unstable
+        << " unstable direction(s) (wrinkling or symmetry breaking; the real balloon may take another shape)\n";
   out << "  material       " << string_field(report, "material");
   if (const std::string name = string_field(report, "material_name"); !name.empty()) out << " (" << name << ")";
   out << ", thickness " << format("%.6g", number_field(report, "thickness_mm")) << " mm\n";

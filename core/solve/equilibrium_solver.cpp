@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -228,12 +229,12 @@ bool EquilibriumSolver::factorize_exact_for_volume(const Eigen::VectorXd& x, dou
     m_skip_ldlt = 2;
     return false;
   }
-  // With one negative pivot and v^T K^-1 v < 0 the bordered KKT matrix has the inertia of a stable
-  // volume-controlled state. Otherwise the state is a saddle under volume control (a wrinkling or
-  // symmetry-breaking mode); Newton still converges to it when started close, and the caller's
-  // residual line search decides whether the step is any good.
-  m_last_unstable_modes = m_solver.negative_pivots();
-  if (m_last_unstable_modes == 1 && v.dot(m_solver.solve(v)) < 0.0) m_last_unstable_modes = 0;
+  // Inertia of the bordered KKT matrix [K v; v^T 0] (Haynsworth): In(K) plus the sign of -v^T K^-1 v.
+  // A stable volume-controlled state has exactly one negative eigenvalue there (the constraint's); each
+  // more is an unstable direction (a wrinkling or symmetry-breaking mode). Newton still converges to such
+  // saddles when started close, and the caller's residual line search decides whether a step is good.
+  const int kkt_negative = m_solver.negative_pivots() + (v.dot(m_solver.solve(v)) > 0.0 ? 1 : 0);
+  m_last_unstable_modes = std::max(0, kkt_negative - 1);
   return true;
 }
 

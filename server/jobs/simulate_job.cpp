@@ -88,6 +88,7 @@ std::string simulate_report_json(const SimulateInput& input, const InflationResu
       .value("factorizations", result.factorizations)
       .value("load_steps", result.load_steps)
       .value("residual_norm", result.residual_norm)
+      .value("unstable_modes", result.unstable_modes)
       .value("time_s", result.time_s)
       .value("vertices", input.rest.vertex_count())
       .value("faces", input.rest.face_count())
@@ -103,26 +104,6 @@ std::string simulate_report_json(const SimulateInput& input, const InflationResu
       .value("message", result.message)
       .end_object();
   return json.str();
-}
-
-std::string simulate_summary_text(const SimulateInput& input, const InflationResult& result) {
-  std::ostringstream out;
-  out << (result.converged ? "converged" : "NOT converged") << " after " << result.newton_iterations
-      << " Newton iterations (" << result.load_steps << " load steps, " << result.factorizations
-      << " factorizations) in " << format_number(result.time_s, "%.3f") << " s\n";
-  if (!result.message.empty()) out << "  " << result.message << "\n";
-  out << "  material       " << material_spec(input.material);
-  if (!input.material.name.empty()) out << " (" << input.material.name << ")";
-  out << ", thickness " << format_number(input.thickness_mm) << " mm\n";
-  out << "  mesh           " << input.rest.vertex_count() << " vertices, " << input.rest.face_count() << " faces"
-      << (input.flipped_orientation ? " (flipped to face outwards)" : "") << "\n";
-  out << "  pressure       " << format_number(result.pressure_kpa) << " kPa\n";
-  out << "  volume         " << format_number(result.volume_mm3) << " mm^3 (rest " << format_number(result.rest_volume_mm3)
-      << " mm^3, ratio " << format_number(result.volume_ratio) << ")\n";
-  out << "  stretch        mean " << format_number(result.mean_stretch) << ", max " << format_number(result.max_stretch)
-      << "\n";
-  out << "  residual norm  " << format_number(result.residual_norm, "%.3e") << " N\n";
-  return out.str();
 }
 
 }  // namespace balloon::jobs

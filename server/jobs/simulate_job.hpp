@@ -59,11 +59,8 @@ struct SimulateOutcome {
 SimulateOutcome run_simulate(const SimulateInput& input, const RunControls& controls);
 
 /// One JSON object: converged, pressure_kpa, volume_mm3, rest_volume_mm3, volume_ratio, mean_stretch,
-/// max_stretch, newton_iterations, factorizations, load_steps, residual_norm (N), time_s, vertices,
-/// faces, material (SPEC), material_name, thickness_mm, control, flipped_orientation, message.
+/// max_stretch, newton_iterations, factorizations, load_steps, residual_norm (N), unstable_modes, time_s,
+/// vertices, faces, material (SPEC), material_name, thickness_mm, control, flipped_orientation, message.
 std::string simulate_report_json(const SimulateInput& input, const InflationResult& result);
-
-/// A few human-readable lines with units, for a terminal.
-std::string simulate_summary_text(const SimulateInput& input, const InflationResult& result);
 
 }  // namespace balloon::jobs

@@ -53,9 +53,10 @@ TEST_F(SimulateCommand, JsonHasTheContractKeysAndReachesTheVolumeRatio) {
   ASSERT_EQ(json.back(), '}');
   for (const char* key : {"converged", "pressure_kpa", "volume_mm3", "rest_volume_mm3", "volume_ratio", "mean_stretch",
                           "max_stretch", "newton_iterations", "residual_norm", "time_s", "vertices", "factorizations",
-                          "load_steps", "message", "material", "thickness_mm", "flipped_orientation"})
+                          "load_steps", "message", "material", "thickness_mm", "flipped_orientation", "unstable_modes"})
     EXPECT_TRUE(json_field(json, key).has_value()) << "missing key " << key;
   EXPECT_EQ(json_field(json, "converged"), "true");
+  EXPECT_GE(json_number_field(json, "unstable_modes"), 0);
   EXPECT_EQ(json_number_field(json, "vertices"), 642);
   EXPECT_NEAR(json_number_field(json, "volume_ratio"), 8.0, 1e-6);
   EXPECT_NEAR(json_number_field(json, "volume_mm3") / json_number_field(json, "rest_volume_mm3"), 8.0, 1e-6);
