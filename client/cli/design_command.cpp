@@ -20,6 +20,7 @@
 #include "jobs/design_job.hpp"
 #include "job_watch.hpp"
 #include "material/material.hpp"
+#include "material_argument.hpp"
 #include "mesh/mesh_io.hpp"
 #include "service_connection.hpp"
 #include "simulate_request.hpp"
@@ -94,17 +95,9 @@ Result<v1::SubmitJobRequest> design_request_from_args(const ParsedArgs& args) {
 
   const std::optional<std::string> spec = args.get("material");
   if (!spec) return fail("missing --material SPEC");
-  const Result<Material> material = parse_material_spec(*spec);
-  if (material) {
-    if (spec->find(':') == std::string::npos)
-      job->mutable_material()->set_name(*spec);
-    else
-      job->mutable_material()->set_spec(*spec);
-  } else if (spec->find(':') == std::string::npos && !spec->empty()) {
-    job->mutable_material()->set_name(*spec);  // perhaps a stored material: the server decides
-  } else {
-    return fail("--material: " + material.error());
-  }
+  Result<v1::MaterialRef> material = material_reference(*spec);
+  if (!material) return fail(material.error());
+  *job->mutable_material() = std::move(*material);
 
   jobs::DesignParameters parameters;
   const auto number = [&](const char* name, auto assign) -> std::string {
@@ -309,15 +302,10 @@ int run_design_command(const std::vector<std::string>& args) {
   const std::string job_id = submitted.job().id();
 
   DesignProgress progress(isatty(STDERR_FILENO) == 1, request->spec().design().max_time_s());
-  const WatchOutcome outcome = watch_job(**connection, job_id, [&](const v1::JobEvent& event) { progress(event); });
-  if (outcome.interrupted) {
-    cancel_job(**connection, job_id);
-    return report_error(COMMAND, "interrupted; job " + job_id + " cancelled", EXIT_INTERRUPTED);
-  }
-  if (!outcome.status.ok()) return report_error(COMMAND, outcome.status.error_message(), exit_code_for(outcome.status));
-  if (outcome.state != v1::JOB_STATE_COMPLETED)
-    return report_error(COMMAND, "job " + job_id + " " + state_name(outcome.state) + ": " + outcome.message,
-                        EXIT_JOB_FAILED);
+  if (const int code = follow_to_completion(**connection, COMMAND, job_id,
+                                           [&](const v1::JobEvent& event) { progress(event); });
+      code != EXIT_OK)
+    return code;
 
   v1::GetResultRequest result_request;
   result_request.set_job_id(job_id);

@@ -8,6 +8,9 @@
 #include <cstdio>
 #include <thread>
 
+#include "cli_output.hpp"
+#include "exit_codes.hpp"
+
 namespace balloon::cli {
 namespace {
 
@@ -108,6 +111,20 @@ void ProgressPrinter::operator()(const balloon::v1::JobEvent& event) {
     std::fprintf(stderr, "%s\n", line);
   }
   std::fflush(stderr);
+}
+
+int follow_to_completion(ServiceConnection& connection, const std::string& command, const std::string& job_id,
+                         const std::function<void(const balloon::v1::JobEvent&)>& on_event) {
+  const WatchOutcome outcome = watch_job(connection, job_id, on_event);
+  if (outcome.interrupted) {
+    cancel_job(connection, job_id);
+    return report_error(command, "interrupted; job " + job_id + " cancelled", EXIT_INTERRUPTED);
+  }
+  if (!outcome.status.ok()) return report_error(command, outcome.status.error_message(), exit_code_for(outcome.status));
+  if (outcome.state != balloon::v1::JOB_STATE_COMPLETED)
+    return report_error(command, "job " + job_id + " " + state_name(outcome.state) + ": " + outcome.message,
+                        EXIT_JOB_FAILED);
+  return EXIT_OK;
 }
 
 }  // namespace balloon::cli

@@ -25,6 +25,12 @@ WatchOutcome watch_job(ServiceConnection& connection, const std::string& job_id,
 /// Asks the service to cancel `job_id` (best effort: after Ctrl-C the CLI exits either way).
 void cancel_job(ServiceConnection& connection, const std::string& job_id);
 
+/// Follows a submitted job to its end for `command`, with its events to `on_event`, cancelling it on
+/// Ctrl-C. EXIT_OK once it completed; otherwise says why on stderr and returns the exit code
+/// (interrupted, the stream's error, or EXIT_JOB_FAILED when the job failed or was cancelled).
+int follow_to_completion(ServiceConnection& connection, const std::string& command, const std::string& job_id,
+                         const std::function<void(const balloon::v1::JobEvent&)>& on_event);
+
 /// Prints progress events on stderr: one updating line on a terminal, plain lines otherwise.
 class ProgressPrinter {
  public:

@@ -128,15 +128,10 @@ int run_simulate_command(const std::vector<std::string>& args) {
   const std::string job_id = submitted.job().id();
 
   ProgressPrinter printer(isatty(STDERR_FILENO) == 1);
-  const WatchOutcome outcome = watch_job(**connection, job_id, [&](const v1::JobEvent& event) { printer(event); });
-  if (outcome.interrupted) {
-    cancel_job(**connection, job_id);
-    return report_error(COMMAND, "interrupted; job " + job_id + " cancelled", EXIT_INTERRUPTED);
-  }
-  if (!outcome.status.ok()) return report_error(COMMAND, outcome.status.error_message(), exit_code_for(outcome.status));
-  if (outcome.state != v1::JOB_STATE_COMPLETED)
-    return report_error(COMMAND, "job " + job_id + " " + state_name(outcome.state) + ": " + outcome.message,
-                        EXIT_JOB_FAILED);
+  if (const int code = follow_to_completion(**connection, COMMAND, job_id,
+                                           [&](const v1::JobEvent& event) { printer(event); });
+      code != EXIT_OK)
+    return code;
 
   v1::GetResultRequest result_request;
   result_request.set_job_id(job_id);

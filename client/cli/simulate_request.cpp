@@ -8,6 +8,7 @@
 
 #include "jobs/simulate_job.hpp"
 #include "material/material.hpp"
+#include "material_argument.hpp"
 
 namespace balloon::cli {
 
@@ -39,18 +40,9 @@ Result<balloon::v1::SubmitJobRequest> simulate_request_from_args(const ParsedArg
 
   const std::optional<std::string> spec = args.get("material");
   if (!spec) return fail("missing --material SPEC");
-  const Result<Material> material = parse_material_spec(*spec);
-  if (material) {
-    // Presets travel by name (the report then names them); inline specs as given.
-    if (spec->find(':') == std::string::npos)
-      job->mutable_material()->set_name(*spec);
-    else
-      job->mutable_material()->set_spec(*spec);
-  } else if (spec->find(':') == std::string::npos && !spec->empty()) {
-    job->mutable_material()->set_name(*spec);  // perhaps a stored material: the server decides
-  } else {
-    return fail("--material: " + material.error());
-  }
+  Result<balloon::v1::MaterialRef> material = material_reference(*spec);
+  if (!material) return fail(material.error());
+  *job->mutable_material() = std::move(*material);
 
   jobs::SimulateParameters parameters;
   if (const auto text = args.get("thickness")) {
