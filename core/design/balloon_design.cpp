@@ -171,9 +171,7 @@ class AdjointDesign {
         distance_gradient += surface_gradient;
         gradient->resize(2 * n);
         gradient->head(n) = rest_force_transpose(zz.head(n), zz.tail(n), w);
-        Eigen::VectorXd rest_part = gradient->head(n);
-        add_regularizer_gradient(zz.head(n), rest_part);
-        gradient->head(n) = rest_part;
+        add_regularizer_gradient(zz.head(n), gradient->head(n));
         gradient->tail(n) = distance_gradient + m_solver.stiffness_times(zz.tail(n), pressure, w);
         for (Eigen::Index c2 = 0; c2 < 2 * n; ++c2)
           if (!free[static_cast<size_t>(c2)]) (*gradient)[c2] = 0.0;
@@ -446,12 +444,15 @@ class AdjointDesign {
       rest = trial_rest;
       m_x = trial_x;
       m_pressure = trial_pressure;
-      if (m_collision->update(rest) > 0 && !m_collision_seen) {
+      const bool was_colliding = m_collision->any_active();
+      const bool colliding = m_collision->update(rest) > 0;
+      if (colliding && !m_collision_seen) {
         m_collision_seen = true;
         result.active_terms.push_back("collision");
       }
       Eigen::VectorXd new_gradient;
-        objective = objective_value(rest, m_x);
+      // The line search already evaluated this point; only a changed set of colliding pairs alters it.
+      objective = colliding || was_colliding ? objective_value(rest, m_x) : trial_objective;
       if (!objective_gradient(rest, new_gradient)) {
         result.message = "the adjoint system could not be factorized";
         break;
@@ -711,7 +712,7 @@ class AdjointDesign {
   }
 
   /// Adds the gradient of regularizer_value to `gradient`.
-  void add_regularizer_gradient(const Eigen::VectorXd& rest, Eigen::VectorXd& gradient) const {
+  void add_regularizer_gradient(const Eigen::VectorXd& rest, Eigen::Ref<Eigen::VectorXd> gradient) const {
     Eigen::VectorXd part;
     if (m_collision->any_active()) {
       m_collision->gradient(rest, part);
@@ -742,9 +743,11 @@ class AdjointDesign {
     Eigen::VectorXd surface_gradient;
     surface_term(m_x, &surface_gradient);
     distance_gradient += surface_gradient;
-    const Eigen::VectorXd v = m_model.volume_gradient(m_x);
+    m_volume_gradient = m_model.volume_gradient(m_x);
+    m_volume_response = m_solver.solve_with_factorization(m_volume_gradient);
+    const Eigen::VectorXd& v = m_volume_gradient;
+    const Eigen::VectorXd& b = m_volume_response;
     const Eigen::VectorXd a = m_solver.solve_with_factorization(distance_gradient);
-    const Eigen::VectorXd b = m_solver.solve_with_factorization(v);
     const double vb = v.dot(b);
     if (!(std::abs(vb) > 0.0)) return false;
     const Eigen::VectorXd lambda = a - (v.dot(a) / vb) * b;
@@ -785,14 +788,16 @@ class AdjointDesign {
     return mixed_product(rest, x, w, true);
   }
 
-  /// d(x, p) for a rest change `direction` at the current equilibrium, using the current factorization:
+  /// d(x, p) for a rest change `direction` at the current equilibrium, using the factorization (and v,
+  /// K^-1 v) that objective_gradient left there:
   /// [K -v; -v^T 0] [dx; dp] = [-(d grad_x W / d rest) direction; 0].
   void linear_response(const Eigen::VectorXd& rest, const Eigen::VectorXd& direction, Eigen::VectorXd& dx,
                        double& dp) const {
     const Eigen::VectorXd rhs = -mixed_product(rest, m_x, direction, false);
-    const Eigen::VectorXd v = m_model.volume_gradient(m_x);
+    // v and K^-1 v at this equilibrium are the ones objective_gradient just computed.
+    const Eigen::VectorXd& v = m_volume_gradient;
+    const Eigen::VectorXd& b = m_volume_response;
     const Eigen::VectorXd a = m_solver.solve_with_factorization(rhs);
-    const Eigen::VectorXd b = m_solver.solve_with_factorization(v);
     const double vb = v.dot(b);
     dp = std::abs(vb) > 0.0 ? -v.dot(a) / vb : 0.0;
     dx = a + dp * b;
@@ -909,6 +914,7 @@ class AdjointDesign {
   NewtonSettings m_settings;
   NewtonReport m_last_report;
   Eigen::VectorXd m_x;
+  Eigen::VectorXd m_volume_gradient, m_volume_response;  ///< v = dV/dx and K^-1 v at m_x (objective_gradient)
   double m_pressure = 0.0;
   double m_best_error = std::numeric_limits<double>::infinity();
   Eigen::VectorXd m_best_rest, m_best_x;
