@@ -179,10 +179,13 @@ Result<MeshCheckReport> validate_balloon_mesh(TriMesh& mesh) {
   if (worst_non_manifold != edge_count) {
     const std::size_t begin = group_starts[worst_non_manifold];
     const std::size_t size = group_starts[worst_non_manifold + 1] - begin;
+    // A face bomb can put 300k faces on one edge: name the first few, count the rest.
+    constexpr std::size_t NAMED_FACES = 4;
     std::string face_list;
-    for (std::size_t i = begin; i < begin + size; ++i) {
+    for (std::size_t i = begin; i < begin + std::min(size, NAMED_FACES); ++i) {
       face_list += (i == begin ? "" : ", ") + str(half_edges[i].face);
     }
+    if (size > NAMED_FACES) face_list += " and " + std::to_string(size - NAMED_FACES) + " more";
     return fail("non-manifold edge " + edge_name(worst_non_manifold) + " shared by " +
                 std::to_string(size) + " faces (faces " + face_list + ")");
   }

@@ -1,10 +1,9 @@
 #include "mesh/mesh_io.hpp"
 
+#include "mesh/assimp_reader.hpp"
+
 #include <Eigen/Geometry>
 
-#include <assimp/Importer.hpp>
-#include <assimp/MemoryIOWrapper.h>
-#include <assimp/scene.h>
 
 #include <algorithm>
 #include <array>
@@ -23,7 +22,6 @@
 #include <stdexcept>
 #include <string_view>
 #include <system_error>
-#include <unordered_map>
 #include <vector>
 
 #include <unistd.h>
@@ -44,12 +42,6 @@ std::string normalize_format(std::string format) {
 
 std::string extension_of(const std::string& path) {
   return normalize_format(std::filesystem::path(path).extension().string());
-}
-
-std::string one_line(std::string text) {
-  std::replace_if(text.begin(), text.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
-  while (!text.empty() && text.back() == ' ') text.pop_back();
-  return text;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -92,11 +84,12 @@ std::vector<std::string_view> tokens_of(std::string_view line, char comment = '#
   return tokens;
 }
 
-// from_chars is locale-independent and exact, unlike strtod under a foreign LC_NUMERIC.
+// from_chars is locale-independent and exact, unlike strtod under a foreign LC_NUMERIC. It also reads
+// "nan" and "inf", which no balloon has: those are refused here, as bad coordinates.
 bool parse_double(std::string_view token, double& value) {
   if (!token.empty() && token.front() == '+') token.remove_prefix(1);
   const auto [end, error] = std::from_chars(token.data(), token.data() + token.size(), value);
-  return error == std::errc() && end == token.data() + token.size();
+  return error == std::errc() && end == token.data() + token.size() && std::isfinite(value);
 }
 
 bool parse_long(std::string_view token, long& value) {
@@ -127,7 +120,7 @@ TriMesh to_mesh(const std::vector<double>& coordinates, const std::vector<int>& 
 // (so the file's vertex order is lost, and OBJ texture seams stay split), and stores single
 // precision. Both formats are a few lines of text; this keeps the file's vertices, order and digits.
 
-Result<TriMesh> parse_obj(std::string_view text) {
+Result<TriMesh> parse_obj(std::string_view text, const MeshReadLimits& limits) {
   std::vector<double> coordinates;
   std::vector<int> indices;
   LineReader lines(text);
@@ -139,6 +132,11 @@ Result<TriMesh> parse_obj(std::string_view text) {
     const std::string where = "line " + std::to_string(lines.line_number());
     if (tokens[0] == "v") {
       if (tokens.size() < 4) return fail(where + ": a vertex needs 3 coordinates");
+      if (const std::string over = over_limit_message(static_cast<std::int64_t>(coordinates.size() / 3) + 1,
+                                                      limits.max_vertices, "vertices");
+          !over.empty()) {
+        return fail(over);
+      }
       for (int k = 1; k <= 3; ++k) {
         double value = 0.0;
         if (!parse_double(tokens[static_cast<std::size_t>(k)], value)) {
@@ -147,6 +145,9 @@ Result<TriMesh> parse_obj(std::string_view text) {
         coordinates.push_back(value);
       }
     } else if (tokens[0] == "f") {
+      if (const std::string over = over_limit_message(face_index + 1, limits.max_faces, "faces"); !over.empty()) {
+        return fail(over);
+      }
       const std::size_t corners = tokens.size() - 1;
       if (corners != 3) {
         return fail("face " + std::to_string(face_index) + " (" + where + ") has " +
@@ -178,7 +179,7 @@ Result<TriMesh> parse_obj(std::string_view text) {
   return to_mesh(coordinates, indices);
 }
 
-Result<TriMesh> parse_off(std::string_view text) {
+Result<TriMesh> parse_off(std::string_view text, const MeshReadLimits& limits) {
   LineReader lines(text);
   std::string_view line;
   std::vector<std::string_view> tokens;
@@ -212,6 +213,17 @@ Result<TriMesh> parse_off(std::string_view text) {
   if (counts.size() < 2 || !parse_long(counts[0], vertex_count) || !parse_long(counts[1], face_count) ||
       vertex_count < 0 || face_count < 0 || vertex_count > INT32_MAX / 3 || face_count > INT32_MAX / 3) {
     return fail(where() + ": bad vertex and face counts");
+  }
+  // A header bomb declares more than the file can hold: a vertex takes at least 6 bytes ("0 0 0\n"),
+  // a face at least 8 ("3 0 1 2\n"). Refused before anything is allocated.
+  if (static_cast<std::size_t>(vertex_count) > text.size() / 6 || static_cast<std::size_t>(face_count) > text.size() / 8) {
+    return fail(where() + ": the header declares " + std::to_string(vertex_count) + " vertices and " +
+                std::to_string(face_count) + " faces, more than a file of " + std::to_string(text.size()) +
+                " bytes can hold");
+  }
+  for (const std::string& over : {over_limit_message(vertex_count, limits.max_vertices, "vertices"),
+                                  over_limit_message(face_count, limits.max_faces, "faces")}) {
+    if (!over.empty()) return fail(over);
   }
 
   std::vector<double> coordinates;
@@ -261,140 +273,12 @@ Result<TriMesh> parse_off(std::string_view text) {
   return to_mesh(coordinates, indices);
 }
 
-// ---------------------------------------------------------------------------------------------
-// STL, PLY and glTF through assimp.
-
-/// Exact position, -0 folded onto +0 so that the two weld.
-struct PositionKey {
-  double x, y, z;
-  bool operator==(const PositionKey& other) const = default;
-};
-struct PositionKeyHash {
-  std::size_t operator()(const PositionKey& p) const {
-    std::uint64_t h = 1469598103934665603ULL;
-    for (const double c : {p.x, p.y, p.z}) {
-      h ^= std::bit_cast<std::uint64_t>(c);
-      h *= 1099511628211ULL;
-      h ^= h >> 29;
-    }
-    return static_cast<std::size_t>(h);
-  }
-};
-
-/// Merges every mesh instance of an assimp scene into one welded triangle mesh.
-class SceneMerger {
- public:
-  explicit SceneMerger(const aiScene& scene) : m_scene(scene) {}
-
-  Result<TriMesh> merge() {
-    if (m_scene.mRootNode != nullptr) visit(*m_scene.mRootNode, Eigen::Matrix4d::Identity());
-    if (!m_instanced) {
-      // No node refers to a mesh (unusual importer output): take the meshes as they are.
-      for (unsigned m = 0; m < m_scene.mNumMeshes && m_error.empty(); ++m) {
-        append(*m_scene.mMeshes[m], Eigen::Matrix4d::Identity());
-      }
-    }
-    if (!m_error.empty()) return fail(m_error);
-    if (m_indices.empty()) {
-      return fail(m_skipped_primitives > 0 ? "no triangles (only points or lines)" : "no triangles");
-    }
-    return to_mesh(m_coordinates, m_indices);
-  }
-
- private:
-  void visit(const aiNode& node, const Eigen::Matrix4d& parent) {
-    Eigen::Matrix4d local;
-    for (int r = 0; r < 4; ++r) {
-      for (int c = 0; c < 4; ++c) local(r, c) = node.mTransformation[r][c];
-    }
-    const Eigen::Matrix4d transform = parent * local;
-    for (unsigned i = 0; i < node.mNumMeshes && m_error.empty(); ++i) {
-      if (node.mMeshes[i] < m_scene.mNumMeshes) {
-        m_instanced = true;
-        append(*m_scene.mMeshes[node.mMeshes[i]], transform);
-      }
-    }
-    for (unsigned i = 0; i < node.mNumChildren && m_error.empty(); ++i) {
-      visit(*node.mChildren[i], transform);
-    }
-  }
-
-  void append(const aiMesh& mesh, const Eigen::Matrix4d& transform) {
-    std::vector<int> welded(mesh.mNumVertices);
-    for (unsigned i = 0; i < mesh.mNumVertices; ++i) {
-      const aiVector3D& p = mesh.mVertices[i];
-      Eigen::Vector3d q = transform.topLeftCorner<3, 3>() * Eigen::Vector3d(p.x, p.y, p.z) +
-                          transform.topRightCorner<3, 1>();
-      for (double& c : q) {
-        if (c == 0.0) c = 0.0;  // -0 becomes +0, so that signed zeros weld
-      }
-      const auto [it, inserted] = m_weld.try_emplace(PositionKey{q.x(), q.y(), q.z()},
-                                                     static_cast<int>(m_coordinates.size() / 3));
-      if (inserted) m_coordinates.insert(m_coordinates.end(), {q.x(), q.y(), q.z()});
-      welded[i] = it->second;
-    }
-    // glTF rule: a mirroring transform (negative determinant) reverses the winding.
-    const bool mirrored = transform.topLeftCorner<3, 3>().determinant() < 0.0;
-    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
-      const aiFace& face = mesh.mFaces[f];
-      if (face.mNumIndices < 3) {  // a point or a line: no surface
-        ++m_skipped_primitives;
-        continue;
-      }
-      if (face.mNumIndices > 3) {
-        m_error = "face " + std::to_string(m_face_index) + " has " + std::to_string(face.mNumIndices) +
-                  " vertices; only triangles are supported";
-        return;
-      }
-      for (const int k : mirrored ? std::array{0, 2, 1} : std::array{0, 1, 2}) {
-        const unsigned index = face.mIndices[k];
-        if (index >= mesh.mNumVertices) {
-          m_error = "face " + std::to_string(m_face_index) + " refers to a missing vertex";
-          return;
-        }
-        m_indices.push_back(welded[index]);
-      }
-      ++m_face_index;
-    }
-  }
-
-  const aiScene& m_scene;
-  std::vector<double> m_coordinates;
-  std::vector<int> m_indices;
-  std::unordered_map<PositionKey, int, PositionKeyHash> m_weld;
-  int m_face_index = 0;
-  int m_skipped_primitives = 0;
-  bool m_instanced = false;
-  std::string m_error;
-};
-
-// No post-processing: aiProcess_Triangulate would hide polygons we must reject, and
-// aiProcess_JoinIdenticalVertices welds within an absolute 1e-5 tolerance in file units (merging
-// distinct vertices of small meshes) and not across meshes; SceneMerger welds exact positions instead.
-constexpr unsigned ASSIMP_FLAGS = 0;
-
-Result<TriMesh> scene_to_mesh(const aiScene* scene, const Assimp::Importer& importer) {
-  if (scene == nullptr) {
-    std::string reason = one_line(importer.GetErrorString());
-    // Reading from memory, assimp names the data after a made-up file; say "the data" instead.
-    const std::string magic = AI_MEMORYIO_MAGIC_FILENAME;
-    for (std::size_t at = reason.find(magic); at != std::string::npos; at = reason.find(magic)) {
-      std::size_t end = at + magic.size();
-      while (end < reason.size() && (std::isalnum(static_cast<unsigned char>(reason[end])) || reason[end] == '.')) ++end;
-      if (end > at + magic.size() && reason[end - 1] == '.') --end;  // keep a sentence's full stop
-      reason.replace(at, end - at, "the data");
-    }
-    return fail("parse error: " + (reason.empty() ? std::string("unknown assimp error") : reason));
-  }
-  return SceneMerger(*scene).merge();
-}
-
 bool uses_assimp(const std::string& format) {
   return format == "stl" || format == "ply" || format == "gltf" || format == "glb";
 }
 
-Result<TriMesh> parse_text_format(const std::string& bytes, const std::string& format) {
-  return format == "obj" ? parse_obj(bytes) : parse_off(bytes);
+Result<TriMesh> parse_text_format(const std::string& bytes, const std::string& format, const MeshReadLimits& limits) {
+  return format == "obj" ? parse_obj(bytes, limits) : parse_off(bytes, limits);
 }
 
 template <class T>
@@ -505,17 +389,16 @@ bool is_writable_mesh_format(const std::string& format) {
   return f == "obj" || f == "stl" || f == "ply";
 }
 
-Result<TriMesh> read_mesh_from_memory(const std::string& bytes, const std::string& format) {
+Result<TriMesh> read_mesh_from_memory(const std::string& bytes, const std::string& format,
+                                      const MeshReadLimits& limits) {
   const std::string f = normalize_format(format);
   const std::string context = "cannot read " + (f.empty() ? std::string("mesh") : f + " mesh") + " data: ";
   if (!is_readable_mesh_format(f)) {
     return fail(context + "unsupported format '" + format + "' (supported: " + READABLE_FORMATS + ")");
   }
   if (bytes.empty()) return fail(context + "no data");
-  if (!uses_assimp(f)) return with_context(parse_text_format(bytes, f), context);
-  Assimp::Importer importer;
-  const aiScene* scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), ASSIMP_FLAGS, f.c_str());
-  return with_context(scene_to_mesh(scene, importer), context);
+  if (!uses_assimp(f)) return with_context(parse_text_format(bytes, f, limits), context);
+  return with_context(read_with_assimp(bytes, f, limits), context);
 }
 
 Result<TriMesh> read_mesh(const std::string& path) {
@@ -534,16 +417,14 @@ Result<TriMesh> read_mesh(const std::string& path) {
     // Through the file (not memory) so that a .gltf finds its external buffers.
     std::ifstream probe(path, std::ios::binary);
     if (!probe) return fail(context + "cannot open the file (" + std::strerror(errno) + ")");
-    Assimp::Importer importer;
-    const aiScene* scene = importer.ReadFile(path, ASSIMP_FLAGS);
-    return with_context(scene_to_mesh(scene, importer), context);
+    return with_context(read_file_with_assimp(path, MeshReadLimits{}), context);
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) return fail(context + "cannot open the file (" + std::strerror(errno) + ")");
   const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   if (in.bad()) return fail(context + "read error");
   if (bytes.empty()) return fail(context + "the file is empty");
-  return with_context(parse_text_format(bytes, f), context);
+  return with_context(parse_text_format(bytes, f, MeshReadLimits{}), context);
 }
 
 std::string write_mesh_to_memory(const TriMesh& mesh, const std::string& format) {

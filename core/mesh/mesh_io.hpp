@@ -2,6 +2,7 @@
 /// Reading and writing triangle meshes. The only place that knows about file formats (and assimp).
 #include <string>
 
+#include "mesh/mesh_read_limits.hpp"
 #include "mesh/tri_mesh.hpp"
 #include "result.hpp"
 
@@ -17,9 +18,13 @@ namespace balloon {
 /// The mesh is not validated: see validate_balloon_mesh.
 Result<TriMesh> read_mesh(const std::string& path);
 
-/// As read_mesh, from the bytes of a file; format is the extension without the dot ("obj", "stl", ...,
-/// case-insensitive). A .gltf must embed its buffers (data: URIs); use glb otherwise.
-Result<TriMesh> read_mesh_from_memory(const std::string& bytes, const std::string& format);
+/// As read_mesh, from the bytes of a file (an upload); format is the extension without the dot ("obj",
+/// "stl", ..., case-insensitive). Reads these bytes and nothing else: a glTF must embed its buffers (data:
+/// URIs) and one naming another file is refused with that name. Non-finite coordinates are refused, and
+/// the counts are checked against `limits` before allocation where the format declares them (OFF, PLY,
+/// binary STL), while parsing otherwise; the message names the count and the limit.
+Result<TriMesh> read_mesh_from_memory(const std::string& bytes, const std::string& format,
+                                      const MeshReadLimits& limits = {});
 
 /// Writes `mesh` (positions in mm) as OBJ (%.9g), binary STL or binary little-endian PLY (double
 /// coordinates), chosen by the extension (case-insensitive). Writes a temporary file in the same

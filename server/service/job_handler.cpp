@@ -108,8 +108,11 @@ static LoadedSimulate load_simulate(const v1::SimulateJob& job, const std::strin
   const std::string extension = mesh_format_extension(job.rest_mesh().format());
   if (extension.empty())
     return failure(StatusCode::InvalidArgument, "rest_mesh.format is missing or unknown (OBJ, STL, PLY, OFF, GLTF, GLB)");
-  Result<TriMesh> mesh = read_mesh_from_memory(job.rest_mesh().data(), extension);
-  if (!mesh) return failure(StatusCode::InvalidArgument, "rest_mesh: " + mesh.error());
+  Result<TriMesh> mesh = read_mesh_from_memory(job.rest_mesh().data(), extension, upload_limits(max_vertices));
+  if (!mesh) {
+    return failure(is_over_limit_error(mesh.error()) ? StatusCode::ResourceExhausted : StatusCode::InvalidArgument,
+                   "rest_mesh: " + mesh.error());
+  }
   if (max_vertices > 0 && mesh->vertex_count() > max_vertices)
     return failure(StatusCode::ResourceExhausted, "rest_mesh has " + std::to_string(mesh->vertex_count()) +
                                                       " vertices, over this server's limit of " +
@@ -151,8 +154,11 @@ static LoadedDesign load_design(const v1::DesignJob& job, const std::string& ten
   const std::string extension = mesh_format_extension(job.target_mesh().format());
   if (extension.empty())
     return failure(StatusCode::InvalidArgument, "target_mesh.format is missing or unknown (OBJ, STL, PLY, OFF, GLTF, GLB)");
-  Result<TriMesh> mesh = read_mesh_from_memory(job.target_mesh().data(), extension);
-  if (!mesh) return failure(StatusCode::InvalidArgument, "target_mesh: " + mesh.error());
+  Result<TriMesh> mesh = read_mesh_from_memory(job.target_mesh().data(), extension, upload_limits(max_vertices));
+  if (!mesh) {
+    return failure(is_over_limit_error(mesh.error()) ? StatusCode::ResourceExhausted : StatusCode::InvalidArgument,
+                   "target_mesh: " + mesh.error());
+  }
   if (max_vertices > 0 && mesh->vertex_count() > max_vertices)
     return failure(StatusCode::ResourceExhausted, "target_mesh has " + std::to_string(mesh->vertex_count()) +
                                                       " vertices, over this server's limit of " +

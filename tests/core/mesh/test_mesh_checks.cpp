@@ -163,6 +163,16 @@ TEST(MeshChecks, RejectsNonManifoldEdges) {
   expect_rejected(mesh, {"non-manifold edge", edge, "shared by 3 faces", "80"});
 }
 
+TEST(MeshChecks, AFaceBombGetsAShortMessage) {
+  // 4 vertices and 300k copies of one face: the message named every face (2.3 MB); now the first few.
+  TriMesh mesh;
+  mesh.vertices = make_icosphere(10.0, 0).vertices.topRows(4);
+  mesh.faces.resize(300000, 3);
+  for (int f = 0; f < mesh.face_count(); ++f) mesh.faces.row(f) << 0, 1, 2;
+  expect_rejected(mesh, {"non-manifold edge", "shared by 300000 faces", "faces 0, 1, 2, 3 and 299996 more"});
+  EXPECT_LT(validate_balloon_mesh(mesh).error().size(), 200u);
+}
+
 TEST(MeshChecks, RejectsOpenBoundary) {
   const TriMesh sphere = make_icosphere(10.0, 1);
   TriMesh mesh = sphere;

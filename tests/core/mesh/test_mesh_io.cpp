@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -525,6 +526,129 @@ TEST(MeshIo, OverwritesAnExistingFile) {
   ASSERT_TRUE(back.ok()) << back.error();
   EXPECT_EQ(back->vertex_count(), 12);
   EXPECT_EQ(dir.entry_count(), 1);
+}
+
+// ------------------------------------------------------------------------------------------------
+// Hostile uploads (issue 11): the reader reads the uploaded bytes and nothing else, and bounds its work.
+
+TEST(MeshIoHostile, GltfNamingAServerFileIsRefusedWithoutReadingIt) {
+  // The buffer lies beside us as a valid one: before the fix, assimp read it and returned the mesh.
+  const TriMesh original = make_icosphere(2.0, 1);
+  TemporaryDirectory dir;
+  const std::string buffer_path = dir.file("secret.bin");
+  write_file(buffer_path, gltf_buffer(original));
+  for (const std::string& uri : {buffer_path, std::string("file://") + buffer_path, std::string("/dev/zero"),
+                                 std::string("secret.bin"), std::string("../../etc/passwd")}) {
+    SCOPED_TRACE(uri);
+    const auto result = read_mesh_from_memory(gltf_json(original, R"([{"mesh":0}])", 1, uri), "gltf");
+    ASSERT_FALSE(result.ok());
+    expect_contains(result.error(), {"cannot read gltf mesh data", "external", uri.substr(0, 40), "data: URIs"});
+  }
+}
+
+TEST(MeshIoHostile, GltfWhoseUriKeyEvadesTheScanIsStillSealed) {
+  // "\u0075ri" is "uri" to a JSON parser but not to the quick scan: the sealed I/O system refuses it.
+  const TriMesh original = make_icosphere(2.0, 1);
+  TemporaryDirectory dir;
+  const std::string buffer_path = dir.file("secret.bin");
+  write_file(buffer_path, gltf_buffer(original));
+  std::string json = gltf_json(original, R"([{"mesh":0}])", 1, buffer_path);
+  const std::size_t key = json.find("\"uri\"");
+  ASSERT_NE(key, std::string::npos);
+  json.replace(key, 5, "\"\\u0075ri\"");
+  const auto result = read_mesh_from_memory(json, "gltf");
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.error().find("parse error: "), std::string::npos) << result.error();
+  expect_contains(result.error(), {"outside the upload", buffer_path});
+}
+
+TEST(MeshIoHostile, GlbWithAnExternalBufferIsRefused) {
+  const TriMesh original = make_icosphere(2.0, 1);
+  std::string binary = glb(original, R"([{"mesh":0}])", 1);
+  // Turn the GLB's own buffer into an external one of the same length: {"byteLength":N} gains a uri.
+  const std::string json = gltf_json(original, R"([{"mesh":0}])", 1, "/etc/hostname");
+  std::string padded = json;
+  padded.resize((json.size() + 3) / 4 * 4, ' ');
+  std::string external = binary.substr(0, 12);
+  const auto u32 = [](std::uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+  external += u32(static_cast<std::uint32_t>(padded.size())) + "JSON" + padded;
+  const auto result = read_mesh_from_memory(external, "glb");
+  ASSERT_FALSE(result.ok());
+  expect_contains(result.error(), {"cannot read glb mesh data", "/etc/hostname"});
+  EXPECT_TRUE(read_mesh_from_memory(binary, "glb").ok());
+}
+
+std::string binary_stl_of_nan_triangles(std::uint32_t triangles) {
+  std::string out(80, ' ');
+  out.append(reinterpret_cast<const char*>(&triangles), 4);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::string record;
+  for (int k = 0; k < 12; ++k) record.append(reinterpret_cast<const char*>(&nan), 4);
+  record.append(2, '\0');
+  for (std::uint32_t t = 0; t < triangles; ++t) out += record;
+  return out;
+}
+
+TEST(MeshIoHostile, NonFiniteCoordinatesAreRefusedBeforeWelding) {
+  // 80k NaN triangles welded in 81 s before (NaN keys never compare equal): now refused at the first vertex.
+  const auto stl = read_mesh_from_memory(binary_stl_of_nan_triangles(80000), "stl");
+  ASSERT_FALSE(stl.ok());
+  expect_contains(stl.error(), {"non-finite", "vertex 0"});
+  for (const char* obj : {"v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "v inf 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+                          "v 1e999 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"}) {
+    SCOPED_TRACE(obj);
+    const auto result = read_mesh_from_memory(obj, "obj");
+    ASSERT_FALSE(result.ok());
+    expect_contains(result.error(), {"line 1", "bad vertex coordinate"});
+  }
+  const auto off = read_mesh_from_memory("OFF\n3 1 0\nnan 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "off");
+  ASSERT_FALSE(off.ok());
+  expect_contains(off.error(), {"bad coordinate", "vertex 0"});
+}
+
+TEST(MeshIoHostile, HeaderBombsAreRefusedBeforeAllocation) {
+  const auto off = read_mesh_from_memory("OFF\n700000000 700000000 0\n0 0 0\n", "off");
+  ASSERT_FALSE(off.ok());
+  expect_contains(off.error(), {"header declares 700000000 vertices", "bytes can hold"});
+  const auto ply = read_mesh_from_memory(
+      "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n",
+      "ply");
+  ASSERT_FALSE(ply.ok());
+  expect_contains(ply.error(), {"bad PLY header", "4000000000 vertex elements"});
+  // A binary STL whose size matches 2M triangles, over a 1M-face limit: refused from the header.
+  std::string stl(84, ' ');
+  const std::uint32_t count = 3;
+  std::memcpy(stl.data() + 80, &count, 4);
+  stl.append(150, '\0');
+  const auto limited = read_mesh_from_memory(stl, "stl", MeshReadLimits{0, 2});
+  ASSERT_FALSE(limited.ok());
+  expect_contains(limited.error(), {"too many faces: 3 (the limit is 2)"});
+  EXPECT_TRUE(is_over_limit_error(limited.error()));
+}
+
+TEST(MeshIoHostile, LimitsHoldForEveryFormat) {
+  const TriMesh sphere = make_icosphere(1.0, 2);  // 162 vertices, 320 faces
+  const MeshReadLimits few_vertices{100, 0};
+  const MeshReadLimits few_faces{0, 100};
+  for (const char* format : {"obj", "stl", "ply"}) {
+    SCOPED_TRACE(format);
+    const std::string bytes = write_mesh_to_memory(sphere, format);
+    ASSERT_TRUE(read_mesh_from_memory(bytes, format, MeshReadLimits{162, 320}).ok());
+    const auto vertices = read_mesh_from_memory(bytes, format, few_vertices);
+    ASSERT_FALSE(vertices.ok());
+    EXPECT_TRUE(is_over_limit_error(vertices.error())) << vertices.error();
+    expect_contains(vertices.error(), {"too many vertices", "limit is 100"});
+    const auto faces = read_mesh_from_memory(bytes, format, few_faces);
+    ASSERT_FALSE(faces.ok());
+    expect_contains(faces.error(), {"too many faces", "limit is 100"});
+  }
+  // glTF instancing repeats one mesh: the limit holds for the merged mesh, not for the file.
+  const auto instanced = read_mesh_from_memory(
+      gltf_embedded(sphere, R"([{"mesh":0},{"mesh":0,"translation":[5,0,0]}])", 2), "gltf", MeshReadLimits{200, 0});
+  ASSERT_FALSE(instanced.ok());
+  expect_contains(instanced.error(), {"too many vertices: 324 (the limit is 200)"});
+  EXPECT_FALSE(is_over_limit_error("face 12 has too many neighbours"));
 }
 
 }  // namespace

@@ -1,0 +1,379 @@
+#include "mesh/assimp_reader.hpp"
+
+#include <Eigen/Geometry>
+
+#include <assimp/IOStream.hpp>
+#include <assimp/IOSystem.hpp>
+#include <assimp/Importer.hpp>
+#include <assimp/MemoryIOWrapper.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+namespace balloon {
+
+namespace {
+
+/// The name under which the uploaded bytes are served to assimp; any other name is refused.
+const std::string MEMORY_FILE_NAME = AI_MEMORYIO_MAGIC_FILENAME;
+
+/// Node trees deeper than this are refused rather than walked (a hostile glTF can nest nodes freely).
+constexpr int MAX_NODE_DEPTH = 256;
+
+/// Mentions of refused files kept for the message; the count is always given.
+constexpr std::size_t NAMED_REFUSALS = 3;
+
+std::string one_line(std::string text) {
+  std::replace_if(text.begin(), text.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
+  while (!text.empty() && text.back() == ' ') text.pop_back();
+  return text;
+}
+
+std::string quoted(std::string_view text) {
+  std::string out(1, '\'');
+  out += text.substr(0, 80);
+  out += text.size() > 80 ? "...'" : "'";
+  return out;
+}
+
+/// An assimp I/O system that can open exactly one file: the uploaded bytes. assimp's own
+/// MemoryIOSystem falls back to the real file system for every other name, which let a glTF buffer
+/// `uri` make the server read (and probe for) its own files. Every other name is refused and recorded.
+class SealedMemoryIOSystem : public Assimp::IOSystem {
+ public:
+  SealedMemoryIOSystem(const std::string& bytes, std::string name) : m_bytes(bytes), m_name(std::move(name)) {}
+
+  bool Exists(const char* file) const override { return file != nullptr && m_name == file; }
+  char getOsSeparator() const override { return '/'; }
+
+  Assimp::IOStream* Open(const char* file, const char* /*mode*/) override {
+    if (file != nullptr && m_name == file) {
+      // MemoryIOStream does not take ownership of the buffer: m_bytes outlives the import.
+      return new Assimp::MemoryIOStream(reinterpret_cast<const std::uint8_t*>(m_bytes.data()), m_bytes.size());
+    }
+    m_refused.emplace_back(file == nullptr ? "" : file);
+    return nullptr;
+  }
+  void Close(Assimp::IOStream* stream) override { delete stream; }
+  bool ComparePaths(const char* one, const char* second) const override { return std::strcmp(one, second) == 0; }
+
+  /// Names assimp asked for other than the uploaded file, in order.
+  const std::vector<std::string>& refused() const { return m_refused; }
+
+ private:
+  const std::string& m_bytes;
+  std::string m_name;
+  std::vector<std::string> m_refused;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Checks on the raw bytes, before assimp allocates anything.
+
+std::uint32_t read_u32(std::string_view bytes, std::size_t at) {
+  std::uint32_t v = 0;
+  for (int k = 3; k >= 0; --k) v = (v << 8) | static_cast<unsigned char>(bytes[at + static_cast<std::size_t>(k)]);
+  return v;
+}
+
+/// The JSON text of a .gltf, or the JSON chunk of a .glb ("" with `error` set when the container is bad).
+std::string_view gltf_json_text(std::string_view bytes, const std::string& format, std::string& error) {
+  if (format == "gltf") return bytes;
+  // GLB: 12-byte header (magic "glTF", version, length), then chunks of (length, type, data); JSON first.
+  if (bytes.size() < 20 || bytes.substr(0, 4) != "glTF") {
+    error = "not a GLB file (no 'glTF' header)";
+    return {};
+  }
+  const std::uint32_t json_length = read_u32(bytes, 12);
+  if (bytes.substr(16, 4) != "JSON" || json_length > bytes.size() - 20) {
+    error = "bad GLB: the first chunk is not a JSON chunk within the file";
+    return {};
+  }
+  return bytes.substr(20, json_length);
+}
+
+/// Every `"uri": "..."` value of a glTF JSON text (escapes left as written; a key spelled with escapes
+/// is not found here, but the sealed I/O system refuses what it names all the same).
+std::vector<std::string_view> gltf_uris(std::string_view json) {
+  std::vector<std::string_view> uris;
+  const std::string_view key = "\"uri\"";
+  for (std::size_t at = json.find(key); at != std::string_view::npos; at = json.find(key, at + key.size())) {
+    std::size_t i = at + key.size();
+    while (i < json.size() && std::isspace(static_cast<unsigned char>(json[i]))) ++i;
+    if (i >= json.size() || json[i] != ':') continue;
+    ++i;
+    while (i < json.size() && std::isspace(static_cast<unsigned char>(json[i]))) ++i;
+    if (i >= json.size() || json[i] != '"') continue;
+    const std::size_t start = ++i;
+    while (i < json.size() && json[i] != '"') i += json[i] == '\\' ? 2 : 1;
+    uris.push_back(json.substr(start, std::min(i, json.size()) - start));
+  }
+  return uris;
+}
+
+/// "" or why a glTF/GLB refers to data outside itself.
+std::string check_gltf_uris(std::string_view bytes, const std::string& format) {
+  std::string error;
+  const std::string_view json = gltf_json_text(bytes, format, error);
+  if (!error.empty()) return error;
+  std::vector<std::string_view> external;
+  for (const std::string_view uri : gltf_uris(json)) {
+    if (uri.substr(0, 5) != "data:") external.push_back(uri);
+  }
+  if (external.empty()) return {};
+  std::string message = "refers to " + std::to_string(external.size()) + " external file" +
+                        (external.size() > 1 ? "s" : "") + " (uri " + quoted(external[0]);
+  if (external.size() > 1) message += ", ...";
+  return message + "); only embedded data: URIs are accepted (use a .glb or embed the buffers)";
+}
+
+bool parse_count(std::string_view token, std::uint64_t& value) {
+  const auto [end, error] = std::from_chars(token.data(), token.data() + token.size(), value);
+  return error == std::errc() && end == token.data() + token.size();
+}
+
+/// "" or why the counts a PLY header declares cannot be right or are over the limits.
+std::string check_ply_header(std::string_view bytes, const MeshReadLimits& limits) {
+  const std::size_t header_end = bytes.find("end_header");
+  if (header_end == std::string_view::npos) return {};  // assimp reports the missing header
+  const std::string_view header = bytes.substr(0, header_end);
+  const std::size_t body = bytes.size() - header_end;
+  for (const auto [name, limit] : {std::pair{std::string_view("vertex"), limits.max_vertices},
+                                   std::pair{std::string_view("face"), limits.max_faces}}) {
+    const std::string prefix = "element " + std::string(name) + " ";
+    const std::size_t at = header.find(prefix);
+    if (at == std::string_view::npos) continue;
+    std::size_t end = at + prefix.size();
+    while (end < header.size() && std::isdigit(static_cast<unsigned char>(header[end]))) ++end;
+    std::uint64_t count = 0;
+    if (!parse_count(header.substr(at + prefix.size(), end - at - prefix.size()), count)) {
+      return "bad PLY header: the " + std::string(name) + " count is not a number";
+    }
+    // Every element takes at least one byte, so a count beyond the bytes left is a lie.
+    if (count > body) {
+      return "bad PLY header: it declares " + std::to_string(count) + " " + std::string(name) +
+             " elements but only " + std::to_string(body) + " bytes follow";
+    }
+    const std::string over = over_limit_message(static_cast<std::int64_t>(count), limit,
+                                                name == "vertex" ? "vertices" : "faces");
+    if (!over.empty()) return over;
+  }
+  return {};
+}
+
+/// "" or why an STL has more triangles than allowed; binary STL declares its count at byte 80. (Its
+/// vertices are known only after welding: SceneMerger checks them.)
+std::string check_stl_size(std::string_view bytes, const MeshReadLimits& limits) {
+  std::uint64_t faces = 0;
+  if (bytes.size() >= 84 && 84 + 50 * static_cast<std::uint64_t>(read_u32(bytes, 80)) == bytes.size()) {
+    faces = read_u32(bytes, 80);
+  } else {  // ASCII (or a binary file assimp will refuse): count the facets.
+    for (std::size_t at = bytes.find("endfacet"); at != std::string_view::npos; at = bytes.find("endfacet", at + 8)) ++faces;
+  }
+  return over_limit_message(static_cast<std::int64_t>(faces), limits.max_faces, "faces");
+}
+
+std::string check_before_parse(std::string_view bytes, const std::string& format, const MeshReadLimits& limits) {
+  if (format == "gltf" || format == "glb") return check_gltf_uris(bytes, format);
+  if (format == "ply") return check_ply_header(bytes, limits);
+  if (format == "stl") return check_stl_size(bytes, limits);
+  return {};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scene to mesh.
+
+/// Exact position, -0 folded onto +0 so that the two weld. Only finite positions are keys (NaN never
+/// equals itself, so NaN keys that hash alike would make the weld quadratic).
+struct PositionKey {
+  double x, y, z;
+  bool operator==(const PositionKey& other) const = default;
+};
+struct PositionKeyHash {
+  std::size_t operator()(const PositionKey& p) const {
+    std::uint64_t h = 1469598103934665603ULL;
+    for (const double c : {p.x, p.y, p.z}) {
+      h ^= std::bit_cast<std::uint64_t>(c);
+      h *= 1099511628211ULL;
+      h ^= h >> 29;
+    }
+    return static_cast<std::size_t>(h);
+  }
+};
+
+/// Merges every mesh instance of an assimp scene into one welded triangle mesh, within the limits.
+class SceneMerger {
+ public:
+  SceneMerger(const aiScene& scene, const MeshReadLimits& limits) : m_scene(scene), m_limits(limits) {}
+
+  Result<TriMesh> merge() {
+    if (m_scene.mRootNode != nullptr) visit(*m_scene.mRootNode, Eigen::Matrix4d::Identity(), 0);
+    if (!m_instanced) {
+      // No node refers to a mesh (unusual importer output): take the meshes as they are.
+      for (unsigned m = 0; m < m_scene.mNumMeshes && m_error.empty(); ++m) {
+        append(*m_scene.mMeshes[m], Eigen::Matrix4d::Identity());
+      }
+    }
+    if (!m_error.empty()) return fail(m_error);
+    if (m_indices.empty()) {
+      return fail(m_skipped_primitives > 0 ? "no triangles (only points or lines)" : "no triangles");
+    }
+    TriMesh mesh;
+    mesh.vertices = Eigen::Map<const Positions>(m_coordinates.data(),
+                                                static_cast<Eigen::Index>(m_coordinates.size() / 3), 3);
+    mesh.faces = Eigen::Map<const Faces>(m_indices.data(), static_cast<Eigen::Index>(m_indices.size() / 3), 3);
+    return mesh;
+  }
+
+ private:
+  void visit(const aiNode& node, const Eigen::Matrix4d& parent, int depth) {
+    if (depth > MAX_NODE_DEPTH) {
+      m_error = "the node tree is deeper than " + std::to_string(MAX_NODE_DEPTH) + " levels";
+      return;
+    }
+    Eigen::Matrix4d local;
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c) local(r, c) = node.mTransformation[r][c];
+    }
+    const Eigen::Matrix4d transform = parent * local;
+    for (unsigned i = 0; i < node.mNumMeshes && m_error.empty(); ++i) {
+      if (node.mMeshes[i] < m_scene.mNumMeshes) {
+        m_instanced = true;
+        append(*m_scene.mMeshes[node.mMeshes[i]], transform);
+      }
+    }
+    for (unsigned i = 0; i < node.mNumChildren && m_error.empty(); ++i) {
+      visit(*node.mChildren[i], transform, depth + 1);
+    }
+  }
+
+  /// Instancing can repeat one mesh many times, so the limits hold for what is merged, not for the file:
+  /// faces before a mesh is appended, welded vertices after (an STL stores 3 vertices per triangle).
+  void append(const aiMesh& mesh, const Eigen::Matrix4d& transform) {
+    m_error = over_limit_message(m_face_index + mesh.mNumFaces, m_limits.max_faces, "faces");
+    if (!m_error.empty()) return;
+    append_within_face_limit(mesh, transform);
+    if (m_error.empty()) {
+      m_error = over_limit_message(static_cast<std::int64_t>(m_coordinates.size() / 3), m_limits.max_vertices, "vertices");
+    }
+  }
+
+  void append_within_face_limit(const aiMesh& mesh, const Eigen::Matrix4d& transform) {
+    if (!transform.allFinite()) {
+      m_error = "a node transform has a non-finite entry";
+      return;
+    }
+    std::vector<int> welded(mesh.mNumVertices);
+    for (unsigned i = 0; i < mesh.mNumVertices; ++i) {
+      const aiVector3D& p = mesh.mVertices[i];
+      Eigen::Vector3d q = transform.topLeftCorner<3, 3>() * Eigen::Vector3d(p.x, p.y, p.z) +
+                          transform.topRightCorner<3, 1>();
+      if (!q.allFinite()) {
+        m_error = "vertex " + std::to_string(i) + " of mesh " + std::to_string(m_meshes_appended) +
+                  " has a non-finite coordinate (NaN or infinite)";
+        return;
+      }
+      for (double& c : q) {
+        if (c == 0.0) c = 0.0;  // -0 becomes +0, so that signed zeros weld
+      }
+      const auto [it, inserted] = m_weld.try_emplace(PositionKey{q.x(), q.y(), q.z()},
+                                                     static_cast<int>(m_coordinates.size() / 3));
+      if (inserted) m_coordinates.insert(m_coordinates.end(), {q.x(), q.y(), q.z()});
+      welded[i] = it->second;
+    }
+    // glTF rule: a mirroring transform (negative determinant) reverses the winding.
+    const bool mirrored = transform.topLeftCorner<3, 3>().determinant() < 0.0;
+    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+      const aiFace& face = mesh.mFaces[f];
+      if (face.mNumIndices < 3) {  // a point or a line: no surface
+        ++m_skipped_primitives;
+        continue;
+      }
+      if (face.mNumIndices > 3) {
+        m_error = "face " + std::to_string(m_face_index) + " has " + std::to_string(face.mNumIndices) +
+                  " vertices; only triangles are supported";
+        return;
+      }
+      for (const int k : mirrored ? std::array{0, 2, 1} : std::array{0, 1, 2}) {
+        const unsigned index = face.mIndices[k];
+        if (index >= mesh.mNumVertices) {
+          m_error = "face " + std::to_string(m_face_index) + " refers to a missing vertex";
+          return;
+        }
+        m_indices.push_back(welded[index]);
+      }
+      ++m_face_index;
+    }
+    ++m_meshes_appended;
+  }
+
+  const aiScene& m_scene;
+  const MeshReadLimits& m_limits;
+  std::vector<double> m_coordinates;
+  std::vector<int> m_indices;
+  std::unordered_map<PositionKey, int, PositionKeyHash> m_weld;
+  std::int64_t m_face_index = 0;
+  int m_meshes_appended = 0;
+  int m_skipped_primitives = 0;
+  bool m_instanced = false;
+  std::string m_error;
+};
+
+// No post-processing: aiProcess_Triangulate would hide polygons we must reject, and
+// aiProcess_JoinIdenticalVertices welds within an absolute 1e-5 tolerance in file units (merging
+// distinct vertices of small meshes) and not across meshes; SceneMerger welds exact positions instead.
+constexpr unsigned ASSIMP_FLAGS = 0;
+
+Result<TriMesh> scene_to_mesh(const aiScene* scene, const Assimp::Importer& importer, const MeshReadLimits& limits) {
+  if (scene == nullptr) {
+    std::string reason = one_line(importer.GetErrorString());
+    // Reading from memory, assimp names the data after a made-up file; say "the data" instead.
+    for (std::size_t at = reason.find(MEMORY_FILE_NAME); at != std::string::npos; at = reason.find(MEMORY_FILE_NAME)) {
+      std::size_t end = at + MEMORY_FILE_NAME.size();
+      while (end < reason.size() && (std::isalnum(static_cast<unsigned char>(reason[end])) || reason[end] == '.')) ++end;
+      if (end > at + MEMORY_FILE_NAME.size() && reason[end - 1] == '.') --end;  // keep a sentence's full stop
+      reason.replace(at, end - at, "the data");
+    }
+    return fail("parse error: " + (reason.empty() ? std::string("unknown assimp error") : reason));
+  }
+  return SceneMerger(*scene, limits).merge();
+}
+
+std::string refused_files_message(const std::vector<std::string>& refused) {
+  std::string message = "refers to a file outside the upload (" + quoted(refused.front());
+  for (std::size_t i = 1; i < std::min(refused.size(), NAMED_REFUSALS); ++i) message += ", " + quoted(refused[i]);
+  if (refused.size() > NAMED_REFUSALS) message += " and " + std::to_string(refused.size() - NAMED_REFUSALS) + " more";
+  return message + "); only the uploaded bytes are read";
+}
+
+}  // namespace
+
+Result<TriMesh> read_with_assimp(const std::string& bytes, const std::string& format, const MeshReadLimits& limits) {
+  if (const std::string problem = check_before_parse(bytes, format, limits); !problem.empty()) return fail(problem);
+  const std::string name = MEMORY_FILE_NAME + "." + format;
+  Assimp::Importer importer;
+  auto* io = new SealedMemoryIOSystem(bytes, name);
+  importer.SetIOHandler(io);  // the importer owns and deletes it
+  const aiScene* scene = importer.ReadFile(name, ASSIMP_FLAGS);
+  // Refused names come first: even when assimp carried on without them, the upload was not self-contained.
+  if (!io->refused().empty()) return fail(refused_files_message(io->refused()));
+  return scene_to_mesh(scene, importer, limits);
+}
+
+Result<TriMesh> read_file_with_assimp(const std::string& path, const MeshReadLimits& limits) {
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(path, ASSIMP_FLAGS);
+  return scene_to_mesh(scene, importer, limits);
+}
+
+}  // namespace balloon
