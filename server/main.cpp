@@ -3,6 +3,7 @@
 #include <semaphore.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -124,8 +125,9 @@ int main(int argc, char** argv) {
   balloon::server::exit_after(command->drain_timeout_s, log_line);
   // The gateway first: it ends its event streams and stops taking requests while the service still answers.
   if (gateway) gateway->stop();
-  // Calls in flight get most of the drain time; the rest is for closing the store.
-  (*server)->shutdown(command->drain_timeout_s * 0.8);
+  // Unary calls in flight finish within milliseconds; streams that never end by themselves (a balancer's
+  // grpc.health.v1 Watch) are cut after this grace, well inside the drain timeout.
+  (*server)->shutdown(std::min(5.0, command->drain_timeout_s * 0.5));
   server->reset();  // closes the store
   log_line("stopped");
   return 0;
