@@ -204,8 +204,8 @@ def main():
     with open(tokens, "w") as f:
         f.writelines(f"{tenant} {TOKENS[tenant]}\n" for tenant in TENANTS)
     cli = Cli(options.cli)
-    small, large = os.path.join(scratch, "small.obj"), os.path.join(scratch, "large.obj")
-    for path, subdivisions in ((small, 2), (large, 4)):
+    small, large, huge = (os.path.join(scratch, f"{size}.obj") for size in ("small", "large", "huge"))
+    for path, subdivisions in ((small, 2), (large, 4), (huge, 5)):
         made = subprocess.run([options.cli, "mesh", "sphere", "--radius", "10", "--subdivisions", str(subdivisions),
                                "--out", path], capture_output=True, text=True)
         check(made.returncode == 0, made.stderr)
@@ -217,7 +217,7 @@ def main():
     try:
         for i in range(len(shards)):
             balancer.wait_for(f"shard{i}", "UP")
-        submitted = run_scenario(cli, shards, balancer, small, large, scratch)
+        submitted = run_scenario(cli, shards, balancer, small, large, huge, scratch)
         if options.measure:
             submitted.update(measure(cli, shards, balancer, small))
     finally:
@@ -244,7 +244,7 @@ def main():
     return 0
 
 
-def run_scenario(cli, shards, balancer, small, large, scratch):
+def run_scenario(cli, shards, balancer, small, large, huge, scratch):
     """Returns {job_id: tenant} for every job submitted."""
     lb = balancer.grpc
     by_name = {shard.name: shard for shard in shards}
@@ -331,7 +331,8 @@ def run_scenario(cli, shards, balancer, small, large, scratch):
     seen, watch_done = [], threading.Event()
     threading.Thread(target=health_watch, args=(drained.grpc, seen, watch_done), daemon=True).start()
     wait_until(lambda: seen == [1], 10, "the health watch to report SERVING")
-    drained_job = cli.json(["submit", large, "--material", "latex", "--volume-ratio", "125"], drained_tenant, lb)["id"]
+    # Large enough to be still running when SIGTERM arrives, even on an idle machine.
+    drained_job = cli.json(["submit", huge, "--material", "latex", "--volume-ratio", "125"], drained_tenant, lb)["id"]
     submitted[drained_job] = drained_tenant
     wait_until(lambda: cli.json(["jobs", "show", drained_job], drained_tenant, lb)["state"] == "JOB_STATE_RUNNING", 30,
                "the job to drain to run")
@@ -415,7 +416,8 @@ def measure(cli, shards, balancer, small):
     request.spec.simulate.volume_ratio = 1.2
     metadata = [("authorization", f"Bearer {TOKENS[tenant]}")]
     submitted = {}
-    for label, address in (("direct", direct), ("balancer", balancer.grpc)):
+    # Alternated twice: on a shared machine the first round also measures warm-up and neighbours.
+    for label, address in (("direct", direct), ("balancer", balancer.grpc)) * 2:
         with grpc.insecure_channel(address) as channel:
             submit = channel.unary_unary("/balloon.v1.BalloonService/SubmitJob",
                                          request_serializer=lambda m: m.SerializeToString(),
