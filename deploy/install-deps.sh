@@ -16,6 +16,9 @@ PACKAGES=(
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler libsqlite3-dev libcpp-httplib-dev
   # cross-language client test
   python3-grpcio python3-protobuf
+  # several shards behind a load balancer (tests/deploy): HAProxy (the test runs its own, unprivileged; the
+  # system service Debian may start has no listeners in its default config); YAML for the Kubernetes check
+  haproxy python3-yaml
   # browser test of the web page (tests/web): headless Chromium driven by playwright-core
   chromium
 )

@@ -1,13 +1,16 @@
 /// balloon-server: the design service on a port. See server_usage() for the flags.
 #include <pthread.h>
+#include <semaphore.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
 #include <iostream>
 #include <mutex>
 
+#include "exit_deadline.hpp"
 #include "http/http_gateway.hpp"
 #include "rpc/grpc_server.hpp"
 #include "server_flags.hpp"
@@ -15,6 +18,15 @@
 namespace {
 
 std::mutex g_log_mutex;
+
+// SIGTERM/SIGINT arrive through a handler, not sigwait: threads that libraries start before main (OpenBLAS's)
+// do not block them, and the default action there would kill the process instead of draining it.
+sem_t g_stop_requested;
+volatile sig_atomic_t g_stop_signal = 0;
+extern "C" void on_stop_signal(int signal_number) {
+  g_stop_signal = signal_number;
+  sem_post(&g_stop_requested);  // async-signal-safe
+}
 
 /// One timestamped line on stderr per job event. Never given tokens.
 void log_line(const std::string& line) {
@@ -43,12 +55,19 @@ int main(int argc, char** argv) {
     std::fputs(balloon::server::server_usage().c_str(), stdout);
     return 0;
   }
-  // Block SIGTERM and SIGINT in every thread (threads inherit the mask); the main thread waits for them.
+  // Block SIGTERM and SIGINT in the threads the server starts (they inherit the mask); the main thread takes them.
   sigset_t signals;
   sigemptyset(&signals);
   sigaddset(&signals, SIGTERM);
   sigaddset(&signals, SIGINT);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  sem_init(&g_stop_requested, 0, 0);
+  struct sigaction on_stop {};
+  on_stop.sa_handler = on_stop_signal;
+  on_stop.sa_flags = SA_RESTART;
+  sigemptyset(&on_stop.sa_mask);
+  sigaction(SIGTERM, &on_stop, nullptr);
+  sigaction(SIGINT, &on_stop, nullptr);
   // A browser that goes away mid-response must cost a failed write, not the process (httplib sends
   // without MSG_NOSIGNAL).
   signal(SIGPIPE, SIG_IGN);
@@ -94,12 +113,21 @@ int main(int argc, char** argv) {
   // One flush for both lines: readers that stop after the first line still find the pipe's whole write.
   std::fflush(stdout);
 
-  int received = 0;
-  sigwait(&signals, &received);
-  log_line(std::string("received ") + (received == SIGTERM ? "SIGTERM" : "SIGINT") + "; shutting down");
+  pthread_sigmask(SIG_UNBLOCK, &signals, nullptr);  // the server's threads keep them blocked; this one takes them
+  while (sem_wait(&g_stop_requested) != 0) {
+  }
+  const int received = g_stop_signal;
+  char drain_seconds[32];
+  std::snprintf(drain_seconds, sizeof(drain_seconds), "%g", command->drain_timeout_s);
+  log_line(std::string("received ") + (received == SIGTERM ? "SIGTERM" : "SIGINT") +
+           "; draining: NOT_SERVING, new jobs refused, running jobs re-queued, exit within " + drain_seconds + " s");
+  (*server)->report_not_serving();
+  balloon::server::exit_after(command->drain_timeout_s, log_line);
   // The gateway first: it ends its event streams and stops taking requests while the service still answers.
   if (gateway) gateway->stop();
-  (*server)->shutdown(5.0);
+  // Unary calls in flight finish within milliseconds; streams that never end by themselves (a balancer's
+  // grpc.health.v1 Watch) are cut after this grace, well inside the drain timeout.
+  (*server)->shutdown(std::min(5.0, command->drain_timeout_s * 0.5));
   server->reset();  // closes the store
   log_line("stopped");
   return 0;

@@ -7,6 +7,8 @@
 #include <map>
 #include <thread>
 
+#include "service/shard_name.hpp"
+
 namespace balloon::server {
 namespace {
 
@@ -18,6 +20,7 @@ const std::map<std::string, bool>& known_flags() {
       {"max-message-mb", true}, {"max-mesh-vertices", true}, {"job-time-limit", true},
       {"progress-mesh-every", true}, {"quiet", false}, {"config", true}, {"help", false},
       {"http", true},         {"web-root", true},
+      {"shard-name", true},   {"drain-timeout", true},
   };
   return flags;
 }
@@ -100,6 +103,10 @@ std::string server_usage() {
          "  --http HOST:PORT         also serve the JSON API (/api/v1) and the web page over HTTP on this\n"
          "                           address, e.g. 127.0.0.1:8080; port 0 picks one [off]\n"
          "  --web-root DIR           the web page's files [" + default_web_root() + "]\n"
+         "  --shard-name NAME        prefix every new job id with NAME ('s2' gives s2-j-...); calls on another\n"
+         "                           shard's job answer FAILED_PRECONDITION; a-z, 0-9, '-', <= 32 chars [none]\n"
+         "  --drain-timeout S        on SIGTERM: NOT_SERVING at once, new jobs refused (UNAVAILABLE), running\n"
+         "                           jobs re-queued; the process ends within S seconds [30]\n"
          "  --insecure-listen-any    allow non-loopback --listen/--http addresses without a token file [off]\n"
          "  --quiet                  no per-job log lines on stderr [off]\n"
          "  --config FILE            read 'name = value' settings first (names as the flags) [none]\n"
@@ -150,7 +157,15 @@ Result<ServerCommand> parse_server_flags(const std::vector<std::string>& args) {
     else if (name == "tls-key") config.tls_key_file = value;
     else if (name == "http") command.http_address = value;
     else if (name == "web-root") command.web_root = value;
-    else if (name == "workers") {
+    else if (name == "shard-name") {
+      Result<std::string> shard = service::check_shard_name(value);
+      if (!shard) return fail(shard.error());
+      config.service.shard_name = *shard;
+    } else if (name == "drain-timeout") {
+      Result<double> s = to_number(name, value);
+      if (!s || *s > 3600.0) return fail("--drain-timeout: '" + value + "' is not a number of seconds in (0, 3600]");
+      command.drain_timeout_s = *s;
+    } else if (name == "workers") {
       Result<long long> n = to_integer(name, value, 1, 1024);
       if (!n) return fail(n.error());
       config.service.workers = static_cast<int>(*n);

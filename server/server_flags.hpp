@@ -15,6 +15,7 @@ struct ServerCommand {
   std::string web_root;      ///< --web-root DIR: the page's files (default: the page CMake built)
   bool help = false;   ///< print server_usage() and exit
   bool quiet = false;  ///< no per-job log lines
+  double drain_timeout_s = 30.0;  ///< --drain-timeout S: after SIGTERM the process ends within this (s)
 };
 
 /// Parses the words after the program name. `--config FILE` reads `name = value` lines (names as the

@@ -2,6 +2,8 @@
 
 #include <mutex>
 
+#include "service/shard_name.hpp"
+
 namespace balloon::rpc {
 namespace {
 
@@ -103,8 +105,9 @@ grpc::Status to_grpc_status(const ServiceStatus& status) {
 }
 
 BalloonServiceImpl::BalloonServiceImpl(service::JobHandler& jobs, service::MaterialHandler& materials,
-                                       const service::TokenTable* tokens, std::function<void(const std::string&)> log)
-    : m_jobs(jobs), m_materials(materials), m_tokens(tokens), m_log(std::move(log)) {}
+                                       const service::TokenTable* tokens, std::function<void(const std::string&)> log,
+                                       std::string shard_name)
+    : m_jobs(jobs), m_materials(materials), m_tokens(tokens), m_log(std::move(log)), m_shard_name(std::move(shard_name)) {}
 
 grpc::Status BalloonServiceImpl::authenticate(grpc::ServerContextBase* context, service::Caller* caller) const {
   if (m_tokens == nullptr) {
@@ -129,6 +132,11 @@ grpc::Status BalloonServiceImpl::call(const char* method, grpc::ServerContextBas
                                       Reply* reply, Handler&& handler) {
   service::Caller caller;
   if (grpc::Status status = authenticate(context, &caller); !status.ok()) return status;
+  // Every call on one job (get, cancel, result, ...) first checks that the id is this shard's.
+  if constexpr (requires { request->job_id(); }) {
+    if (const service::ServiceStatus shard = service::check_job_shard(m_shard_name, request->job_id()); !shard.ok())
+      return to_grpc_status(shard);
+  }
   try {
     return to_grpc_status(handler(caller, *request, reply));
   } catch (const std::exception& error) {
@@ -193,6 +201,7 @@ grpc::ServerWriteReactor<v1::JobEvent>* BalloonServiceImpl::WatchJob(grpc::Callb
                                                                      const v1::WatchJobRequest* request) {
   service::Caller caller;
   grpc::Status status = authenticate(context, &caller);
+  if (status.ok()) status = to_grpc_status(service::check_job_shard(m_shard_name, request->job_id()));
   std::shared_ptr<service::WatchChannel> channel;
   if (status.ok()) {
     try {

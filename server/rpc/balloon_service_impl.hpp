@@ -18,9 +18,10 @@ using BalloonServiceBase =
 
 class BalloonServiceImpl final : public BalloonServiceBase {
  public:
-  /// `tokens` null: no authentication, every caller is the local tenant. `log` may be empty.
+  /// `tokens` null: no authentication, every caller is the local tenant. `log` may be empty. A job call
+  /// whose id names another shard than `shard_name` answers FAILED_PRECONDITION (service/shard_name).
   BalloonServiceImpl(service::JobHandler& jobs, service::MaterialHandler& materials, const service::TokenTable* tokens,
-                     std::function<void(const std::string&)> log);
+                     std::function<void(const std::string&)> log, std::string shard_name = {});
 
   grpc::Status SubmitJob(grpc::ServerContext* context, const balloon::v1::SubmitJobRequest* request,
                          balloon::v1::SubmitJobResponse* reply) override;
@@ -54,6 +55,7 @@ class BalloonServiceImpl final : public BalloonServiceBase {
   service::MaterialHandler& m_materials;
   const service::TokenTable* m_tokens;
   std::function<void(const std::string&)> m_log;
+  std::string m_shard_name;
 };
 
 /// A handler status as a grpc::Status (same code, same message).

@@ -87,7 +87,8 @@ Result<std::unique_ptr<GrpcServer>> GrpcServer::start(const ServerConfig& config
   internals->materials = std::make_unique<service::MaterialHandler>(*internals->store);
   internals->jobs = std::make_unique<service::JobHandler>(config.service, *internals->store, *internals->materials);
   internals->service = std::make_unique<BalloonServiceImpl>(
-      *internals->jobs, *internals->materials, internals->tokens ? &*internals->tokens : nullptr, config.service.log);
+      *internals->jobs, *internals->materials, internals->tokens ? &*internals->tokens : nullptr, config.service.log,
+      config.service.shard_name);
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
@@ -115,6 +116,10 @@ std::shared_ptr<grpc::Channel> GrpcServer::in_process_channel() {
   arguments.SetMaxReceiveMessageSize(-1);
   arguments.SetMaxSendMessageSize(-1);
   return m_internals->server->InProcessChannel(arguments);
+}
+
+void GrpcServer::report_not_serving() {
+  if (auto* health = m_internals->server->GetHealthCheckService()) health->SetServingStatus(false);
 }
 
 void GrpcServer::shutdown(double grace_s) {

@@ -38,6 +38,8 @@ class GrpcServer {
   /// Jobs re-queued from the store at start.
   int recovered_jobs() const;
 
+  /// Tells health checks (grpc.health.v1, service "") NOT_SERVING from now on: the first step of a drain.
+  void report_not_serving();
   /// Stops accepting jobs, stops running ones (re-queued in the store), ends watch streams, then shuts
   /// the gRPC server down, waiting at most `grace_s` for calls in flight. Idempotent.
   void shutdown(double grace_s = 5.0);

@@ -1,4 +1,5 @@
 #include "service/job_handler.hpp"
+#include "service/shard_name.hpp"
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -320,7 +321,7 @@ std::string JobHandler::new_job_id() {
   z ^= z >> 31;
   char buffer[24];
   std::snprintf(buffer, sizeof(buffer), "j-%016llx", static_cast<unsigned long long>(z));
-  return buffer;
+  return shard_job_id(m_options.shard_name, buffer);
 }
 
 ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobRequest& request,

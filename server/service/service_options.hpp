@@ -16,6 +16,7 @@ struct ServiceOptions {
   double checkpoint_interval_s = 0.25;  ///< at most one stored progress checkpoint per job per interval (s)
   bool recover = true;                  ///< re-queue unfinished jobs at start (only if no other process uses the store)
   bool run_jobs = true;                 ///< false: accept and store jobs but start no workers (a short-lived CLI)
+  std::string shard_name;               ///< --shard-name: prefixes every new job id ("s2-j-..."); empty: none
   /// Receives one log line per job event; empty for silence (the embedded CLI server).
   std::function<void(const std::string&)> log;
 };
