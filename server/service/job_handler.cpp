@@ -774,9 +774,7 @@ void JobHandler::run_design_job(const store::JobRecord& record, const v1::JobSpe
   result.inflated_mesh = store::encode_mesh_blob(TriMesh{outcome.result.inflated, outcome.result.rest.faces});
   result.report_json = outcome.report_json;
   if (!m_jobs.mark_completed(record.row_id, result)) return;  // cancelled as it finished: that already published
-  char errors[128];
-  std::snprintf(errors, sizeof(errors), "avg error %.3g mm (%.2g%% of %.3g mm)", outcome.result.avg_error_mm,
-                100.0 * outcome.result.avg_error_rel, outcome.result.bbox_diag_mm);
+  const std::string errors = jobs::design_error_summary(outcome.result);
   const std::string message = (outcome.result.converged ? "completed: converged in " : "completed without converging in ") +
                               format_number(outcome.result.time_s) + " s, " + errors +
                               (outcome.result.converged ? std::string() : ": " + outcome.result.message);
