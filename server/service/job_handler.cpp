@@ -337,6 +337,9 @@ ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobReques
   }
   if (spec.priority() < -100 || spec.priority() > 100)
     return ServiceStatus::error(StatusCode::InvalidArgument, "priority must be within -100..100");
+  if (spec.priority() > 0 && !caller.may_raise_priority)
+    return ServiceStatus::error(StatusCode::PermissionDenied,
+                                "priority above 0 is only for tenants marked 'raise-priority' in the token file");
   if (!std::isfinite(spec.time_limit_s()) || spec.time_limit_s() < 0.0)
     return ServiceStatus::error(StatusCode::InvalidArgument, "time_limit_s must be a finite number >= 0 (s)");
 
