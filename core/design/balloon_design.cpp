@@ -85,6 +85,13 @@ std::string format_fraction(double fraction) {
   return text;
 }
 
+/// A ratio as a short human string: 131.4 -> "131x", 0.002 -> "0.002x".
+std::string format_ratio(double ratio) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.3gx", ratio);
+  return text;
+}
+
 Positions scaled_about_centroid(const Positions& points, double scale) {
   const Eigen::RowVector3d center = points.colwise().mean();
   Positions scaled = (points.rowwise() - center) * scale;
@@ -461,8 +468,8 @@ class AdjointDesign {
                                                      format_fraction(OPTIMALITY_TOLERANCE) + " of its start value");
         } else {
           stop_with(result, DesignStop::Stalled,
-                    "stalled: no decrease along the steepest descent (design gradient still " +
-                        format_fraction(gradient.norm() / initial_gradient_norm) + " of its start value)");
+                    "stalled: no decrease along the steepest descent (design gradient at " +
+                        format_ratio(gradient.norm() / initial_gradient_norm) + " its start value)");
         }
         break;
       }
