@@ -4,9 +4,10 @@
 // inflated under volume control to ratio 2 and 8 (27 for latex), 0.5 mm thick. Meshes above
 // --resolution * 1.25 vertices are remeshed to --resolution vertices with the design's target
 // preparation (CGAL isotropic remeshing); smaller ones keep their slivers. Prints one line per case and
-// the number of failures (a case fails when the solver does not report converged).
+// the number of failures (a case fails when the solver does not report converged). --tension-field
+// switches on Pipkin's relaxation (InflationOptions::tension_field, off by default).
 // Usage: bench_robustness [DATA_DIR] [--mesh SUBSTRING]... [--material silicone|latex|neo-hookean]
-//                         [--resolution N=4000] [--max-time S=120] [--quick]
+//                         [--resolution N=4000] [--max-time S=120] [--tension-field] [--quick]
 //   --quick: 200 mm as given, the largest ratio only (one case per mesh and material).
 #include <algorithm>
 #include <chrono>
@@ -63,6 +64,7 @@ int main(int argc, char** argv) {
   int resolution = 4000;
   double max_time_s = 120.0;
   bool quick = false;
+  bool tension_field = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     auto value = [&]() -> std::string {
@@ -73,6 +75,7 @@ int main(int argc, char** argv) {
       return argv[++i];
     };
     if (arg == "--quick") quick = true;
+    else if (arg == "--tension-field") tension_field = true;
     else if (arg == "--mesh") mesh_filters.push_back(value());
     else if (arg == "--material") material_filters.push_back(value());
     else if (arg == "--resolution") resolution = std::atoi(value().c_str());
@@ -145,6 +148,7 @@ int main(int argc, char** argv) {
             options.control = balloon::InflationControl::VolumeRatio;
             options.volume_ratio = ratio;
             options.max_time_s = max_time_s;
+            options.tension_field = tension_field;
             const balloon::InflationResult result = balloon::inflate(rest, options);
             ++cases;
             times.push_back(result.time_s);
