@@ -628,7 +628,7 @@ class AdjointDesign {
   }
 
   bool stopped() const {
-    return m_last_report.message == "cancelled" || m_last_report.message == "time limit reached";
+    return m_last_report.stop == NewtonStop::Cancelled || m_last_report.stop == NewtonStop::TimeLimit;
   }
 
   /// Volume-controlled equilibrium of `rest` from (x, p); false when it does not converge.
