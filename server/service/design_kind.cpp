@@ -1,0 +1,125 @@
+// The design job kind: the inverse design of a target (jobs/design_job), storing the rest and inflated
+// meshes and the report.
+#include <algorithm>
+#include <cstdio>
+
+#include "jobs/design_job.hpp"
+#include "mesh/mesh_io.hpp"
+#include "service/job_kind.hpp"
+#include "store/mesh_blob.hpp"
+
+namespace balloon::service {
+namespace {
+
+namespace v1 = balloon::v1;
+
+/// Decodes and checks a design job and prepares its target (mesh within `max_vertices`, material,
+/// parameters).
+ServiceStatus load_design(const v1::DesignJob& job, const std::string& tenant, int max_vertices,
+                          MaterialHandler& materials, std::optional<jobs::DesignInput>* loaded) {
+  if (job.target_mesh().data().empty())
+    return ServiceStatus::error(StatusCode::InvalidArgument, "target_mesh is empty");
+  const std::string extension = mesh_format_extension(job.target_mesh().format());
+  if (extension.empty())
+    return ServiceStatus::error(StatusCode::InvalidArgument,
+                                "target_mesh.format is missing or unknown (OBJ, STL, PLY, OFF, GLTF, GLB)");
+  Result<TriMesh> mesh = read_mesh_from_memory(job.target_mesh().data(), extension);
+  if (!mesh) return ServiceStatus::error(StatusCode::InvalidArgument, "target_mesh: " + mesh.error());
+  if (max_vertices > 0 && mesh->vertex_count() > max_vertices)
+    return ServiceStatus::error(StatusCode::ResourceExhausted,
+                                "target_mesh has " + std::to_string(mesh->vertex_count()) +
+                                    " vertices, over this server's limit of " + std::to_string(max_vertices));
+  Result<Material> material = materials.resolve(tenant, job.material());
+  if (!material) return ServiceStatus::error(StatusCode::InvalidArgument, "material: " + material.error());
+
+  jobs::DesignParameters parameters;
+  parameters.thickness_mm = job.thickness_mm() == 0.0 ? jobs::DEFAULT_THICKNESS_MM : job.thickness_mm();
+  parameters.size_mm = job.size_mm();
+  // On the wire 0 means the default and < 0 "never remesh" (proto3 has no unset ints); here 0 never remeshes.
+  parameters.resolution = job.resolution() == 0 ? jobs::DEFAULT_DESIGN_RESOLUTION : std::max(0, job.resolution());
+  if (job.inflation_case() == v1::DesignJob::kScale) parameters.scale = job.scale();
+  if (job.inflation_case() == v1::DesignJob::kVolumeRatio) parameters.volume_ratio = job.volume_ratio();
+  parameters.method = job.method();
+  parameters.nozzle = job.nozzle();
+  parameters.max_time_s = job.max_time_s();
+  parameters.tolerance_samples = job.tolerance_samples();
+  if (max_vertices > 0 && parameters.resolution > max_vertices)
+    return ServiceStatus::error(StatusCode::ResourceExhausted,
+                                "resolution " + std::to_string(parameters.resolution) + " is over this server's limit of " +
+                                    std::to_string(max_vertices) + " vertices");
+  Result<jobs::DesignInput> input = jobs::prepare_design(std::move(*mesh), *material, parameters);
+  if (!input) {
+    std::string message = input.error();
+    if (message.rfind("mesh: ", 0) == 0) message = "target_" + message;
+    return ServiceStatus::error(StatusCode::InvalidArgument, message);
+  }
+  *loaded = std::move(*input);
+  return ServiceStatus::success();
+}
+
+std::string design_summary(const jobs::DesignInput& input) {
+  std::string summary = "design " + std::to_string(input.target.mesh.vertex_count()) + " vertices, " +
+                        (input.material.name.empty() ? material_spec(input.material) : input.material.name) + ", " +
+                        format_number(input.parameters.thickness_mm) + " mm, " + design_method_name(input.method) + ", ";
+  if (input.parameters.scale)
+    summary += "scale " + format_number(*input.parameters.scale);
+  else
+    summary += "V/V0=" + format_number(input.parameters.volume_ratio ? *input.parameters.volume_ratio
+                                                                     : DesignOptions{}.volume_ratio);
+  return summary;
+}
+
+class DesignKind final : public JobKind {
+ public:
+  const char* name() const override { return "design"; }
+  v1::JobKind proto_kind() const override { return v1::JOB_KIND_DESIGN; }
+
+  ServiceStatus check(const v1::JobSpec& spec, const CheckContext& context, CheckedJob* checked) const override {
+    std::optional<jobs::DesignInput> input;
+    const ServiceStatus status =
+        load_design(spec.design(), context.caller.tenant, context.max_mesh_vertices, context.materials, &input);
+    if (!status.ok()) return status;
+    checked->stored_spec = spec;
+    if (names_stored_material(spec.design().material()))
+      checked->stored_spec.mutable_design()->mutable_material()->set_spec(material_spec(input->material));
+    checked->summary = design_summary(*input);
+    return ServiceStatus::success();
+  }
+
+  RunOutcome run(RunContext& context) const override {
+    // The limit on vertices was applied at submit time; a job accepted then runs now even if the limit shrank.
+    std::optional<jobs::DesignInput> loaded;
+    const ServiceStatus status = load_design(context.spec.design(), context.record.owner, 0, context.materials, &loaded);
+    if (!status.ok()) return RunOutcome::failed(status.message);
+    const jobs::DesignInput& input = *loaded;
+    context.set_connectivity(input.target.mesh.faces);
+    jobs::RunControls controls;
+    controls.cancel = &context.cancel;
+    controls.progress = context.progress;
+    const jobs::DesignOutcome outcome = jobs::run_design(input, controls);
+    if (context.cancel.cancelled()) return RunOutcome::stopped();
+    if (outcome.result.rest.vertex_count() == 0)
+      return RunOutcome::failed("the design produced no rest shape: " + outcome.result.message);
+    store::ResultRecord result;
+    result.converged = outcome.result.converged;
+    result.rest_mesh = store::encode_mesh_blob(outcome.result.rest);
+    result.inflated_mesh = store::encode_mesh_blob(TriMesh{outcome.result.inflated, outcome.result.rest.faces});
+    result.report_json = outcome.report_json;
+    char errors[128];
+    std::snprintf(errors, sizeof(errors), "avg error %.3g mm (%.2g%% of %.3g mm)", outcome.result.avg_error_mm,
+                  100.0 * outcome.result.avg_error_rel, outcome.result.bbox_diag_mm);
+    std::string message = (outcome.result.converged ? "completed: converged in " : "completed without converging in ") +
+                          format_number(outcome.result.time_s) + " s, " + errors +
+                          (outcome.result.converged ? std::string() : ": " + outcome.result.message);
+    return RunOutcome::completed(std::move(result), std::move(message));
+  }
+};
+
+}  // namespace
+
+const JobKind& design_kind() {
+  static const DesignKind kind;
+  return kind;
+}
+
+}  // namespace balloon::service
