@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "jobs/design_job.hpp"
+#include "mesh/mesh_checks.hpp"
 #include "mesh/mesh_io.hpp"
 #include "service/job_kind.hpp"
 #include "store/mesh_blob.hpp"
@@ -13,10 +14,20 @@ namespace {
 
 namespace v1 = balloon::v1;
 
-/// Decodes and checks a design job and prepares its target (mesh within `max_vertices`, material,
-/// parameters).
-ServiceStatus load_design(const v1::DesignJob& job, const std::string& tenant, int max_vertices,
-                          MaterialHandler& materials, std::optional<jobs::DesignInput>* loaded) {
+/// prepare_target's smallest resolution (vertices) other than 0.
+constexpr int MIN_REMESH_RESOLUTION = 100;
+
+/// A design request decoded and checked, its target not yet prepared (no remeshing).
+struct DecodedDesign {
+  TriMesh target;
+  Material material;
+  jobs::DesignParameters parameters;
+};
+
+/// Decodes and checks a design job: the mesh (within `max_vertices`), the material and the parameters.
+/// Cheap: the target is read and, with `check_mesh`, checked closed and manifold, but not remeshed.
+ServiceStatus decode_design(const v1::DesignJob& job, const std::string& tenant, int max_vertices, bool check_mesh,
+                            MaterialHandler& materials, DecodedDesign* decoded) {
   if (job.target_mesh().data().empty())
     return ServiceStatus::error(StatusCode::InvalidArgument, "target_mesh is empty");
   const std::string extension = mesh_format_extension(job.target_mesh().format());
@@ -32,7 +43,7 @@ ServiceStatus load_design(const v1::DesignJob& job, const std::string& tenant, i
   Result<Material> material = materials.resolve(tenant, job.material());
   if (!material) return ServiceStatus::error(StatusCode::InvalidArgument, "material: " + material.error());
 
-  jobs::DesignParameters parameters;
+  jobs::DesignParameters& parameters = decoded->parameters;
   parameters.thickness_mm = job.thickness_mm() == 0.0 ? jobs::DEFAULT_THICKNESS_MM : job.thickness_mm();
   parameters.size_mm = job.size_mm();
   // On the wire 0 means the default and < 0 "never remesh" (proto3 has no unset ints); here 0 never remeshes.
@@ -47,7 +58,29 @@ ServiceStatus load_design(const v1::DesignJob& job, const std::string& tenant, i
     return ServiceStatus::error(StatusCode::ResourceExhausted,
                                 "resolution " + std::to_string(parameters.resolution) + " is over this server's limit of " +
                                     std::to_string(max_vertices) + " vertices");
-  Result<jobs::DesignInput> input = jobs::prepare_design(std::move(*mesh), *material, parameters);
+  if (check_mesh) {
+    // What prepare_design checks before its remeshing, in the same words; the remeshing itself (seconds
+    // of CGAL for a large target) runs once, on the worker.
+    if (const std::string problem = jobs::design_parameters_problem(parameters); !problem.empty())
+      return ServiceStatus::error(StatusCode::InvalidArgument, problem);
+    if (const std::string problem = material_problem(*material); !problem.empty())
+      return ServiceStatus::error(StatusCode::InvalidArgument, "material: " + problem);
+    if (parameters.resolution > 0 && parameters.resolution < MIN_REMESH_RESOLUTION)
+      return ServiceStatus::error(StatusCode::InvalidArgument,
+                                  "target_mesh: resolution must be 0 (never remesh) or at least 100 vertices, got " +
+                                      std::to_string(parameters.resolution));
+    TriMesh checked = *mesh;
+    if (Result<MeshCheckReport> report = validate_balloon_mesh(checked); !report)
+      return ServiceStatus::error(StatusCode::InvalidArgument, "target_mesh: target mesh: " + report.error());
+  }
+  decoded->target = std::move(*mesh);
+  decoded->material = std::move(*material);
+  return ServiceStatus::success();
+}
+
+/// Prepares a decoded design (remeshing the target): the worker's part.
+ServiceStatus prepare(DecodedDesign decoded, std::optional<jobs::DesignInput>* loaded) {
+  Result<jobs::DesignInput> input = jobs::prepare_design(std::move(decoded.target), decoded.material, decoded.parameters);
   if (!input) {
     std::string message = input.error();
     if (message.rfind("mesh: ", 0) == 0) message = "target_" + message;
@@ -57,15 +90,18 @@ ServiceStatus load_design(const v1::DesignJob& job, const std::string& tenant, i
   return ServiceStatus::success();
 }
 
-std::string design_summary(const jobs::DesignInput& input) {
-  std::string summary = "design " + std::to_string(input.target.mesh.vertex_count()) + " vertices, " +
-                        (input.material.name.empty() ? material_spec(input.material) : input.material.name) + ", " +
-                        format_number(input.parameters.thickness_mm) + " mm, " + design_method_name(input.method) + ", ";
-  if (input.parameters.scale)
-    summary += "scale " + format_number(*input.parameters.scale);
+/// One line for the job list; the vertex count is the target's as uploaded (remeshing comes later).
+std::string design_summary(const DecodedDesign& design) {
+  const jobs::DesignParameters& parameters = design.parameters;
+  const DesignMethod method =
+      parameters.method.empty() ? DesignOptions{}.method : *parse_design_method(parameters.method);
+  std::string summary = "design " + std::to_string(design.target.vertex_count()) + " vertices, " +
+                        (design.material.name.empty() ? material_spec(design.material) : design.material.name) + ", " +
+                        format_number(parameters.thickness_mm) + " mm, " + design_method_name(method) + ", ";
+  if (parameters.scale)
+    summary += "scale " + format_number(*parameters.scale);
   else
-    summary += "V/V0=" + format_number(input.parameters.volume_ratio ? *input.parameters.volume_ratio
-                                                                     : DesignOptions{}.volume_ratio);
+    summary += "V/V0=" + format_number(parameters.volume_ratio ? *parameters.volume_ratio : DesignOptions{}.volume_ratio);
   return summary;
 }
 
@@ -75,21 +111,24 @@ class DesignKind final : public JobKind {
   v1::JobKind proto_kind() const override { return v1::JOB_KIND_DESIGN; }
 
   ServiceStatus check(const v1::JobSpec& spec, const CheckContext& context, CheckedJob* checked) const override {
-    std::optional<jobs::DesignInput> input;
-    const ServiceStatus status =
-        load_design(spec.design(), context.caller.tenant, context.max_mesh_vertices, context.materials, &input);
+    DecodedDesign decoded;
+    const ServiceStatus status = decode_design(spec.design(), context.caller.tenant, context.max_mesh_vertices, true,
+                                               context.materials, &decoded);
     if (!status.ok()) return status;
     checked->stored_spec = spec;
     if (names_stored_material(spec.design().material()))
-      checked->stored_spec.mutable_design()->mutable_material()->set_spec(material_spec(input->material));
-    checked->summary = design_summary(*input);
+      checked->stored_spec.mutable_design()->mutable_material()->set_spec(material_spec(decoded.material));
+    checked->summary = design_summary(decoded);
     return ServiceStatus::success();
   }
 
   RunOutcome run(RunContext& context) const override {
     // The limit on vertices was applied at submit time; a job accepted then runs now even if the limit shrank.
+    DecodedDesign decoded;
+    ServiceStatus status = decode_design(context.spec.design(), context.record.owner, 0, false, context.materials, &decoded);
+    if (!status.ok()) return RunOutcome::failed(status.message);
     std::optional<jobs::DesignInput> loaded;
-    const ServiceStatus status = load_design(context.spec.design(), context.record.owner, 0, context.materials, &loaded);
+    status = prepare(std::move(decoded), &loaded);
     if (!status.ok()) return RunOutcome::failed(status.message);
     const jobs::DesignInput& input = *loaded;
     context.set_connectivity(input.target.mesh.faces);

@@ -136,14 +136,22 @@ ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobReques
   if (!std::isfinite(spec.time_limit_s()) || spec.time_limit_s() < 0.0)
     return ServiceStatus::error(StatusCode::InvalidArgument, "time_limit_s must be a finite number >= 0 (s)");
 
-  CheckedJob checked;
-  const ServiceStatus status =
-      kind->check(spec, CheckContext{caller, m_materials, m_options.max_mesh_vertices}, &checked);
-  if (!status.ok()) return status;
-
+  // The queue check comes before any parsing: a full queue costs the server nothing.
   if (!m_queue.reserve())
     return ServiceStatus::error(StatusCode::ResourceExhausted,
                                 "the queue is full (" + std::to_string(m_queue.capacity()) + " jobs waiting); retry later");
+  CheckedJob checked;
+  ServiceStatus status;
+  try {
+    status = kind->check(spec, CheckContext{caller, m_materials, m_options.max_mesh_vertices}, &checked);
+  } catch (...) {
+    m_queue.release_reservation();
+    throw;
+  }
+  if (!status.ok()) {
+    m_queue.release_reservation();
+    return status;
+  }
   store::JobRecord record;
   record.job_id = new_job_id();
   record.owner = caller.tenant;
