@@ -73,8 +73,8 @@ class FitMaterialKind final : public JobKind {
     const v1::FitMaterialJob& job = context.spec.fit_material();
     std::optional<jobs::FitInput> input;
     if (const ServiceStatus checked = check_fit(job, &input); !checked.ok()) return RunOutcome::failed(checked.message);
-    // The fit has no iteration callback: it cannot be stopped midway, only its outcome discarded.
-    Result<jobs::FitOutcome> outcome = jobs::run_fit(*input);
+    // The fit checks the token between iterations: cancel, the time limit and shutdown stop it midway.
+    Result<jobs::FitOutcome> outcome = jobs::run_fit(*input, &context.cancel);
     if (context.cancel.cancelled()) return RunOutcome::stopped();
     if (!outcome) return RunOutcome::failed(outcome.error());
     const FitResult& best = outcome->fits[static_cast<size_t>(jobs::best_fit_index(*outcome))];

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <thread>
 
 #include "mesh/mesh_io.hpp"
 #include "store/mesh_blob.hpp"
@@ -22,6 +23,7 @@ using store::JobState;
 constexpr int MAX_PAGE_SIZE = 1000;
 constexpr int DEFAULT_PAGE_SIZE = 100;
 constexpr double SHAPE_CHECKPOINT_INTERVAL_S = 1.0;  // stored shapes are big: at most one a second per job
+constexpr int FAIL_WRITE_ATTEMPTS = 3;               // tries to record a failure before leaving it to the next start
 v1::JobState to_proto(JobState state) {
   switch (state) {
     case JobState::Queued: return v1::JOB_STATE_QUEUED;
@@ -99,7 +101,9 @@ int JobHandler::start() {
   if (!m_options.run_jobs) return 0;  // a client-only process: leave every job as the store has it
   const bool sole_user = acquire_store_lock();
   if (m_options.recover && sole_user) {
-    for (const store::JobRecord& job : m_jobs.recover_unfinished()) {
+    const store::JobStore::Recovery recovery = m_jobs.recover_unfinished(m_options.max_attempts);
+    for (const store::JobRecord& job : recovery.crashed) log("job " + job.job_id + " failed: " + job.error);
+    for (const store::JobRecord& job : recovery.queued) {
       m_queue.push_recovered(job.row_id, job.priority);
       ++recovered;
     }
@@ -237,9 +241,12 @@ ServiceStatus JobHandler::cancel(const Caller& caller, const v1::CancelJobReques
   auto record = find_owned(caller, request.job_id());
   if (!record) return ServiceStatus::error(StatusCode::NotFound, "no job '" + request.job_id() + "'");
   if (!store::is_terminal(record->state)) {
-    m_queue.remove(record->row_id);
+    // The store first: if its write fails the job is still queued (in memory and on disk) and the caller
+    // gets an error; a worker that pops it meanwhile finds it cancelled and skips it.
     const std::string reason = "cancelled by its owner";
-    if (m_jobs.mark_cancelled(record->row_id, reason)) {
+    const bool cancelled = m_jobs.mark_cancelled(record->row_id, reason);
+    m_queue.remove(record->row_id);
+    if (cancelled) {
       // A running job stops at its next iteration; its state is final already.
       m_pool.stop(record->row_id, StopReason::Cancelled);
       log("job " + record->job_id + " cancelled");
@@ -348,7 +355,21 @@ void JobHandler::finish_run(const store::JobRecord& record, const JobKind&, cons
 }
 
 void JobHandler::fail_job(const store::JobRecord& record, const std::string& error) {
-  m_jobs.mark_failed(record.row_id, error);
+  // A store failure here must not leave the row in 'running' while the server lives on: retry a few
+  // times; if the store still refuses, the next start applies the attempts rule to the row.
+  for (int attempt = 1;; ++attempt) {
+    try {
+      m_jobs.mark_failed(record.row_id, error);
+      break;
+    } catch (const std::exception& store_error) {
+      if (attempt == FAIL_WRITE_ATTEMPTS) {
+        log("job " + record.job_id + ": could not record its failure (" + store_error.what() +
+            "); the next start re-queues it or fails it by --max-attempts");
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(100 * attempt));
+    }
+  }
   log("job " + record.job_id + " failed: " + error);
   m_watches.finish(record.job_id, state_event(record.job_id, v1::JOB_STATE_FAILED, error));
 }
@@ -404,7 +425,11 @@ ProgressCallback JobHandler::progress_publisher(const store::JobRecord& record, 
 void JobHandler::finish_stopped(const store::JobRecord& record, const ActiveJob& active) {
   switch (active.reason()) {
     case StopReason::Shutdown:
-      m_jobs.mark_requeued(record.row_id);
+      try {
+        m_jobs.mark_requeued(record.row_id);
+      } catch (const std::exception& error) {
+        log("job " + record.job_id + ": could not re-queue it (" + error.what() + "); the next start does");
+      }
       log("job " + record.job_id + " interrupted by shutdown; it runs again at the next start");
       break;
     case StopReason::TimeLimit:

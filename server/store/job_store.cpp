@@ -33,6 +33,8 @@ constexpr const char* MARK_CANCELLED =
     "WHERE id = ? AND state IN ('queued', 'running')";
 constexpr const char* MARK_REQUEUED = "UPDATE jobs SET state = 'queued' WHERE id = ? AND state = 'running'";
 constexpr const char* REQUEUE_ALL_RUNNING = "UPDATE jobs SET state = 'queued' WHERE state = 'running'";
+constexpr const char* SELECT_CRASHED_JOBS =
+    "SELECT " JOB_COLUMNS JOB_FROM "WHERE jobs.state = 'running' AND jobs.attempts >= ? ORDER BY jobs.id ASC";
 constexpr const char* MARK_COMPLETED =
     "UPDATE jobs SET state = 'completed', converged = ?, finished_ms = ?, error = '' "
     "WHERE id = ? AND state = 'running'";
@@ -252,17 +254,32 @@ std::optional<ResultRecord> JobStore::result(std::int64_t row_id) {
   return result;
 }
 
-std::vector<JobRecord> JobStore::recover_unfinished() {
+JobStore::Recovery JobStore::recover_unfinished(int max_attempts) {
   std::lock_guard lock(m_store.mutex());
   Transaction transaction(m_store.database());
+  Recovery recovery;
+  if (max_attempts > 0) {
+    {
+      Statement statement = m_store.database().prepare(SELECT_CRASHED_JOBS);
+      statement.bind(1, max_attempts);
+      while (statement.step()) recovery.crashed.push_back(read_job(statement));
+    }
+    const std::int64_t now = now_ms();
+    for (JobRecord& job : recovery.crashed) {
+      job.state = JobState::Failed;
+      job.error = "crashed the server " + std::to_string(job.attempts) + " times (--max-attempts " +
+                  std::to_string(max_attempts) + "); it is not run again";
+      job.finished_ms = now;
+      m_store.database().prepare(MARK_FAILED).bind(1, job.error).bind(2, now).bind(3, job.row_id).run();
+    }
+  }
   m_store.database().execute(REQUEUE_ALL_RUNNING);
-  std::vector<JobRecord> jobs;
   {
     Statement statement = m_store.database().prepare(SELECT_QUEUED_JOBS);
-    while (statement.step()) jobs.push_back(read_job(statement));
+    while (statement.step()) recovery.queued.push_back(read_job(statement));
   }
   transaction.commit();
-  return jobs;
+  return recovery;
 }
 
 }  // namespace balloon::store

@@ -104,9 +104,15 @@ class JobStore {
   /// The stored result of a completed job.
   std::optional<ResultRecord> result(std::int64_t row_id);
 
-  /// After a crash: every Running job becomes Queued again. Returns all Queued jobs, by priority
-  /// (highest first) then age (oldest first), without their specs' progress.
-  std::vector<JobRecord> recover_unfinished();
+  /// What recover_unfinished did.
+  struct Recovery {
+    std::vector<JobRecord> queued;   ///< every Queued job afterwards, by priority (highest first) then age
+    std::vector<JobRecord> crashed;  ///< Running jobs that had used up their attempts, now Failed
+  };
+  /// After a crash: a Running job (it was running when the process died) becomes Queued again, unless it
+  /// has started `max_attempts` times already: then it becomes Failed with "crashed the server N times"
+  /// (a job that kills the process must not crash it at every restart). max_attempts <= 0: no limit.
+  Recovery recover_unfinished(int max_attempts);
 
  private:
   Store& m_store;
