@@ -1,10 +1,13 @@
 #include "service_connection.hpp"
 
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
+#include <thread>
 
 #include "exit_codes.hpp"
 #include "rpc/grpc_server.hpp"
@@ -102,11 +105,38 @@ void ServiceConnection::prepare(grpc::ClientContext& context) const {
   if (!m_token.empty()) context.AddMetadata("authorization", "Bearer " + m_token);
 }
 
+namespace {
+
+/// Tries of one submission when the server cannot be reached (a lost reply included).
+constexpr int SUBMIT_TRIES = 3;
+
+/// 128 random bits as 32 hex digits: the submission's idempotency key.
+std::string new_request_id() {
+  std::random_device device;
+  char buffer[40];
+  std::snprintf(buffer, sizeof(buffer), "%08x%08x%08x%08x", device(), device(), device(), device());
+  return buffer;
+}
+
+}  // namespace
+
 grpc::Status ServiceConnection::submit(const balloon::v1::SubmitJobRequest& request,
                                        balloon::v1::SubmitJobResponse* reply) {
-  grpc::ClientContext context;
-  prepare(context);
-  return m_stub->SubmitJob(&context, request, reply);
+  // One request id per submission, reused by its retries: a reply lost on the way back must not leave
+  // a second job behind (the server returns the first job for a repeated id).
+  balloon::v1::SubmitJobRequest sent = request;
+  if (sent.request_id().empty()) sent.set_request_id(new_request_id());
+  grpc::Status status;
+  for (int attempt = 1; attempt <= SUBMIT_TRIES; ++attempt) {
+    grpc::ClientContext context;
+    prepare(context);
+    status = m_stub->SubmitJob(&context, sent, reply);
+    if (status.error_code() != grpc::StatusCode::UNAVAILABLE &&
+        status.error_code() != grpc::StatusCode::DEADLINE_EXCEEDED)
+      break;
+    if (attempt < SUBMIT_TRIES) std::this_thread::sleep_for(std::chrono::milliseconds(250 * attempt));
+  }
+  return status;
 }
 
 std::string message_naming_file(const grpc::Status& status, const std::string& field, const std::string& path) {

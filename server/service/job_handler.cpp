@@ -23,7 +23,19 @@ using store::JobState;
 constexpr int MAX_PAGE_SIZE = 1000;
 constexpr int DEFAULT_PAGE_SIZE = 100;
 constexpr double SHAPE_CHECKPOINT_INTERVAL_S = 1.0;  // stored shapes are big: at most one a second per job
-constexpr int FAIL_WRITE_ATTEMPTS = 3;               // tries to record a failure before leaving it to the next start
+constexpr int FAIL_WRITE_ATTEMPTS = 3;
+constexpr std::size_t MAX_REQUEST_ID_LENGTH = 128;
+constexpr std::int64_t REQUEST_ID_WINDOW_MS = 24LL * 3600 * 1000;  // a repeat within 24 h returns the first job
+
+/// Empty when `request_id` is a usable idempotency key, else the problem.
+std::string request_id_problem(const std::string& request_id) {
+  if (request_id.size() > MAX_REQUEST_ID_LENGTH)
+    return "request_id is " + std::to_string(request_id.size()) + " characters long, over the limit of " +
+           std::to_string(MAX_REQUEST_ID_LENGTH);
+  for (const char c : request_id)
+    if (c < 0x21 || c > 0x7e) return "request_id must be printable ASCII without spaces";
+  return "";
+}               // tries to record a failure before leaving it to the next start
 v1::JobState to_proto(JobState state) {
   switch (state) {
     case JobState::Queued: return v1::JOB_STATE_QUEUED;
@@ -140,6 +152,19 @@ ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobReques
   if (!std::isfinite(spec.time_limit_s()) || spec.time_limit_s() < 0.0)
     return ServiceStatus::error(StatusCode::InvalidArgument, "time_limit_s must be a finite number >= 0 (s)");
 
+  const std::string& request_id = request.request_id();
+  if (const std::string problem = request_id_problem(request_id); !problem.empty())
+    return ServiceStatus::error(StatusCode::InvalidArgument, problem);
+  // A retry of a submission that reached the store returns the first job: nothing is parsed or stored.
+  const auto first_submission = [&]() -> std::optional<store::JobRecord> {
+    if (request_id.empty()) return std::nullopt;
+    return m_jobs.find_request(caller.tenant, request_id, now_ms() - REQUEST_ID_WINDOW_MS);
+  };
+  if (const auto first = first_submission()) {
+    fill_job(*first, reply->mutable_job());
+    return ServiceStatus::success();
+  }
+
   // The queue check comes before any parsing: a full queue costs the server nothing.
   if (!m_queue.reserve())
     return ServiceStatus::error(StatusCode::ResourceExhausted,
@@ -168,11 +193,22 @@ ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobReques
     m_queue.release_reservation();
     return ServiceStatus::error(StatusCode::Internal, "could not serialize the job spec");
   }
-  try {
-    m_jobs.insert(record);
-  } catch (...) {
-    m_queue.release_reservation();
-    throw;
+  record.request_id = request_id;
+  {
+    // Two copies of one request in flight at once: the second finds the first here.
+    std::unique_lock request_lock(m_request_mutex, std::defer_lock);
+    if (!request_id.empty()) request_lock.lock();
+    try {
+      if (const auto first = first_submission()) {
+        m_queue.release_reservation();
+        fill_job(*first, reply->mutable_job());
+        return ServiceStatus::success();
+      }
+      m_jobs.insert(record);
+    } catch (...) {
+      m_queue.release_reservation();
+      throw;
+    }
   }
   m_queue.push_reserved(record.row_id, record.priority);
   log("job " + record.job_id + " submitted by " + caller.tenant + ": " + record.summary);

@@ -91,6 +91,7 @@ class JobHandler {
   bool m_started = false;
   int m_lock_fd = -1;
 
+  std::mutex m_request_mutex;  // held from the request_id lookup to the insert
   std::mutex m_id_mutex;
   std::uint64_t m_id_state = 0;
 };

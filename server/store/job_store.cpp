@@ -4,21 +4,24 @@ namespace balloon::store {
 namespace {
 
 constexpr const char* INSERT_JOB =
-    "INSERT INTO jobs (job_id, owner, kind, state, priority, spec, summary, created_ms) "
-    "VALUES (?, ?, ?, ?, ?, ?, ?, ?)";
+    "INSERT INTO jobs (job_id, owner, kind, state, priority, spec, summary, created_ms, request_id) "
+    "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)";
 
 // The latest progress row of each job joins in through its maximum id (index progress_job).
 #define JOB_COLUMNS                                                                                     \
   "jobs.id, jobs.job_id, jobs.owner, jobs.kind, jobs.state, jobs.priority, jobs.spec, jobs.summary, "  \
   "jobs.error, jobs.converged, jobs.created_ms, jobs.started_ms, jobs.finished_ms, jobs.attempts, "     \
   "p.phase, p.iteration, p.elapsed_s, p.residual_norm, p.pressure_kpa, p.avg_error_mm, p.max_error_mm, " \
-  "p.recorded_ms "
+  "p.recorded_ms, jobs.request_id "
 #define JOB_FROM                                                                                        \
   "FROM jobs LEFT JOIN progress AS p ON p.id = "                                                        \
   "(SELECT MAX(id) FROM progress WHERE progress.job_row = jobs.id) "
 
 constexpr const char* SELECT_JOB_BY_ID = "SELECT " JOB_COLUMNS JOB_FROM "WHERE jobs.job_id = ?";
 constexpr const char* SELECT_JOB_BY_ROW = "SELECT " JOB_COLUMNS JOB_FROM "WHERE jobs.id = ?";
+constexpr const char* SELECT_JOB_BY_REQUEST =
+    "SELECT " JOB_COLUMNS JOB_FROM
+    "WHERE jobs.owner = ? AND jobs.request_id = ? AND jobs.created_ms >= ? ORDER BY jobs.id DESC LIMIT 1";
 constexpr const char* SELECT_JOBS_PAGE =
     "SELECT " JOB_COLUMNS JOB_FROM
     "WHERE jobs.owner = ? AND jobs.id < ? AND (? = '' OR jobs.state = ?) ORDER BY jobs.id DESC LIMIT ?";
@@ -87,6 +90,7 @@ JobRecord read_job(const Statement& row) {
     progress.recorded_ms = row.column_int64(21);
     job.last_progress = progress;
   }
+  job.request_id = row.column_text(22);
   return job;
 }
 
@@ -120,7 +124,8 @@ void JobStore::insert(JobRecord& job) {
       .bind(5, job.priority)
       .bind_blob(6, job.spec)
       .bind(7, job.summary)
-      .bind(8, job.created_ms);
+      .bind(8, job.created_ms)
+      .bind(9, job.request_id);
   statement.run();
   job.row_id = m_store.database().last_insert_id();
 }
@@ -137,6 +142,15 @@ std::optional<JobRecord> JobStore::find_row(std::int64_t row_id) {
   std::lock_guard lock(m_store.mutex());
   Statement statement = m_store.database().prepare(SELECT_JOB_BY_ROW);
   statement.bind(1, row_id);
+  if (!statement.step()) return std::nullopt;
+  return read_job(statement);
+}
+
+std::optional<JobRecord> JobStore::find_request(const std::string& owner, const std::string& request_id,
+                                                std::int64_t since_ms) {
+  std::lock_guard lock(m_store.mutex());
+  Statement statement = m_store.database().prepare(SELECT_JOB_BY_REQUEST);
+  statement.bind(1, owner).bind(2, request_id).bind(3, since_ms);
   if (!statement.step()) return std::nullopt;
   return read_job(statement);
 }

@@ -50,6 +50,7 @@ struct JobRecord {
   std::int64_t started_ms = 0;
   std::int64_t finished_ms = 0;
   int attempts = 0;
+  std::string request_id;      ///< the client's idempotency key; empty: none
   std::optional<ProgressRecord> last_progress;  ///< filled by find() and list()
 };
 
@@ -78,6 +79,8 @@ class JobStore {
   std::optional<JobRecord> find(const std::string& job_id);
   /// The job with this row id.
   std::optional<JobRecord> find_row(std::int64_t row_id);
+  /// The owner's newest job submitted with `request_id` at or after `since_ms` (ms since the epoch).
+  std::optional<JobRecord> find_request(const std::string& owner, const std::string& request_id, std::int64_t since_ms);
   /// The owner's jobs with row id < before_row (0: from the newest), optionally in one state.
   JobPage list(const std::string& owner, std::optional<JobState> state, std::int64_t before_row, int limit);
 

@@ -173,5 +173,40 @@ TEST(ServiceLifecycle, AJobFoundRunningAfterMaxAttemptsFailsInsteadOfRunningAgai
   EXPECT_EQ(retried.attempts(), 3);
 }
 
+TEST(ServiceLifecycle, ARepeatedRequestIdReturnsTheFirstJobAndStoresNothing) {
+  ScratchDir scratch;
+  const std::string tokens = scratch.file("tokens.txt");
+  std::ofstream(tokens) << "alice token-alice-0123456789\nbob token-bob-0123456789ab\n";
+  ServerProcess server(scratch.file("jobs.db"), {"--token-file", tokens, "--workers", "1"});
+  auto stub = server.stub();
+  v1::SubmitJobRequest request = simulate_request(2, 2.0);
+  request.set_request_id("retry-7f3a");
+  std::string first, repeat, other_tenant, other_id;
+  ASSERT_TRUE(submit(*stub, request, &first, "token-alice-0123456789").ok());
+  ASSERT_TRUE(submit(*stub, request, &repeat, "token-alice-0123456789").ok());
+  EXPECT_EQ(repeat, first);
+  // The key is the tenant's own: another tenant with the same key gets its own job.
+  ASSERT_TRUE(submit(*stub, request, &other_tenant, "token-bob-0123456789ab").ok());
+  EXPECT_NE(other_tenant, first);
+  request.set_request_id("retry-7f3b");
+  ASSERT_TRUE(submit(*stub, request, &other_id, "token-alice-0123456789").ok());
+  EXPECT_NE(other_id, first);
+  // Still the first job once it has finished.
+  ASSERT_EQ(wait_for(*stub, first, v1::JOB_STATE_COMPLETED, 30, "token-alice-0123456789").state(), v1::JOB_STATE_COMPLETED);
+  request.set_request_id("retry-7f3a");
+  ASSERT_TRUE(submit(*stub, request, &repeat, "token-alice-0123456789").ok());
+  EXPECT_EQ(repeat, first);
+  grpc::ClientContext context;
+  add_token(context, "token-alice-0123456789");
+  v1::ListJobsResponse listed;
+  ASSERT_TRUE(stub->ListJobs(&context, v1::ListJobsRequest(), &listed).ok());
+  EXPECT_EQ(listed.jobs_size(), 2);
+  // Bounded: a 129-character key is refused.
+  request.set_request_id(std::string(129, 'k'));
+  const grpc::Status refused = submit(*stub, request, &repeat, "token-alice-0123456789");
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(refused.error_message().find("request_id"), std::string::npos) << refused.error_message();
+}
+
 }  // namespace
 }  // namespace balloon::testing
