@@ -77,7 +77,8 @@ v1::JobEvent state_event(const std::string& job_id, v1::JobState state, const st
 
 JobHandler::JobHandler(const ServiceOptions& options, store::Store& store, MaterialHandler& materials)
     : m_options(options), m_store(store), m_jobs(store), m_materials(materials),
-      m_queue(static_cast<std::size_t>(std::max(1, options.max_queue))),
+      m_queue(static_cast<std::size_t>(std::max(1, options.max_queue)), options.max_queued_per_tenant,
+              options.max_running_per_tenant),
       m_pool(m_queue, [this](std::int64_t row_id) { run_job(row_id); }, options.log) {
   std::random_device device;
   m_id_state = (static_cast<std::uint64_t>(device()) << 32) ^ device() ^
@@ -116,7 +117,7 @@ int JobHandler::start() {
     const store::JobStore::Recovery recovery = m_jobs.recover_unfinished(m_options.max_attempts);
     for (const store::JobRecord& job : recovery.crashed) log("job " + job.job_id + " failed: " + job.error);
     for (const store::JobRecord& job : recovery.queued) {
-      m_queue.push_recovered(job.row_id, job.priority);
+      m_queue.push_recovered(job.row_id, job.owner, job.priority);
       ++recovered;
     }
     if (recovered > 0) log("recovered " + std::to_string(recovered) + " unfinished job(s) from " + m_store.path());
@@ -165,20 +166,41 @@ ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobReques
     return ServiceStatus::success();
   }
 
-  // The queue check comes before any parsing: a full queue costs the server nothing.
-  if (!m_queue.reserve())
-    return ServiceStatus::error(StatusCode::ResourceExhausted,
-                                "the queue is full (" + std::to_string(m_queue.capacity()) + " jobs waiting); retry later");
+  // The queue and quota checks come before any parsing: a refused job costs the server nothing.
+  switch (m_queue.reserve(caller.tenant)) {
+    case JobQueue::Reservation::Reserved: break;
+    case JobQueue::Reservation::QueueFull:
+      return ServiceStatus::error(StatusCode::ResourceExhausted, "the queue is full (" +
+                                                                     std::to_string(m_queue.capacity()) +
+                                                                     " jobs waiting); retry later");
+    case JobQueue::Reservation::TenantFull:
+      return ServiceStatus::error(StatusCode::ResourceExhausted,
+                                  "quota max-queued-per-tenant: " + std::to_string(m_options.max_queued_per_tenant) +
+                                      " jobs of yours are queued, the limit; retry when some have started");
+  }
+  if (m_options.max_stored_mb_per_tenant > 0) {
+    const std::int64_t limit = static_cast<std::int64_t>(m_options.max_stored_mb_per_tenant) << 20;
+    const std::int64_t stored = m_jobs.stored_bytes(caller.tenant);
+    if (stored + static_cast<std::int64_t>(request.ByteSizeLong()) > limit) {
+      m_queue.release_reservation(caller.tenant);
+      char used[32];
+      std::snprintf(used, sizeof(used), "%.1f", static_cast<double>(stored) / (1 << 20));
+      return ServiceStatus::error(StatusCode::ResourceExhausted,
+                                  "quota max-stored-mb-per-tenant: your jobs store " + std::string(used) +
+                                      " MiB, the limit is " + std::to_string(m_options.max_stored_mb_per_tenant) +
+                                      " MiB with this job; delete finished jobs (DeleteJob) first");
+    }
+  }
   CheckedJob checked;
   ServiceStatus status;
   try {
     status = kind->check(spec, CheckContext{caller, m_materials, m_options.max_mesh_vertices}, &checked);
   } catch (...) {
-    m_queue.release_reservation();
+    m_queue.release_reservation(caller.tenant);
     throw;
   }
   if (!status.ok()) {
-    m_queue.release_reservation();
+    m_queue.release_reservation(caller.tenant);
     return status;
   }
   store::JobRecord record;
@@ -190,7 +212,7 @@ ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobReques
   record.summary = checked.summary;
   record.created_ms = now_ms();
   if (!checked.stored_spec.SerializeToString(&record.spec)) {
-    m_queue.release_reservation();
+    m_queue.release_reservation(caller.tenant);
     return ServiceStatus::error(StatusCode::Internal, "could not serialize the job spec");
   }
   record.request_id = request_id;
@@ -200,17 +222,17 @@ ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobReques
     if (!request_id.empty()) request_lock.lock();
     try {
       if (const auto first = first_submission()) {
-        m_queue.release_reservation();
+        m_queue.release_reservation(caller.tenant);
         fill_job(*first, reply->mutable_job());
         return ServiceStatus::success();
       }
       m_jobs.insert(record);
     } catch (...) {
-      m_queue.release_reservation();
+      m_queue.release_reservation(caller.tenant);
       throw;
     }
   }
-  m_queue.push_reserved(record.row_id, record.priority);
+  m_queue.push_reserved(record.row_id, record.owner, record.priority);
   log("job " + record.job_id + " submitted by " + caller.tenant + ": " + record.summary);
   fill_job(record, reply->mutable_job());
   return ServiceStatus::success();
@@ -316,7 +338,7 @@ ServiceStatus JobHandler::watch(const Caller& caller, const v1::WatchJobRequest&
     }
     return ServiceStatus::success();
   };
-  return m_watches.open(request.job_id(), caller.tenant, 0, first_events, channel);
+  return m_watches.open(request.job_id(), caller.tenant, m_options.max_watches_per_tenant, first_events, channel);
 }
 
 void JobHandler::unwatch(const std::shared_ptr<WatchChannel>& channel) { m_watches.close(channel); }

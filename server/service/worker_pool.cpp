@@ -20,13 +20,14 @@ void WorkerPool::start(int workers) {
 }
 
 void WorkerPool::worker_loop() {
-  while (const std::optional<std::int64_t> row = m_queue.pop()) {
+  while (const std::optional<JobQueue::Popped> popped = m_queue.pop()) {
     try {
-      m_run(*row);
+      m_run(popped->row_id);
     } catch (const std::exception& error) {
       // A job must never take its worker down with it.
       if (m_log) m_log(std::string("worker: unexpected error: ") + error.what());
     }
+    m_queue.done(popped->tenant);
   }
 }
 

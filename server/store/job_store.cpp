@@ -57,6 +57,13 @@ constexpr const char* INSERT_PROGRESS =
     "max_error_mm, recorded_ms, shape) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)";
 constexpr const char* SELECT_LATEST_SHAPE =
     "SELECT shape FROM progress WHERE job_row = ? AND shape IS NOT NULL ORDER BY id DESC LIMIT 1";
+// length() of a BLOB reads its size, not its bytes.
+constexpr const char* SELECT_STORED_BYTES =
+    "SELECT (SELECT COALESCE(SUM(LENGTH(spec) + LENGTH(summary) + LENGTH(error)), 0) FROM jobs WHERE owner = ?) + "
+    "(SELECT COALESCE(SUM(LENGTH(r.rest_mesh) + LENGTH(r.inflated_mesh) + LENGTH(CAST(r.report_json AS BLOB))), 0) "
+    " FROM results AS r JOIN jobs AS j ON j.id = r.job_row WHERE j.owner = ?) + "
+    "(SELECT COALESCE(SUM(COALESCE(LENGTH(p.shape), 0) + 64), 0) "
+    " FROM progress AS p JOIN jobs AS j ON j.id = p.job_row WHERE j.owner = ?)";
 constexpr const char* COUNT_PROGRESS = "SELECT COUNT(*) FROM progress WHERE job_row = ?";
 
 #undef JOB_COLUMNS
@@ -252,6 +259,13 @@ int JobStore::progress_count(std::int64_t row_id) {
   Statement statement = m_store.database().prepare(COUNT_PROGRESS);
   statement.bind(1, row_id);
   return statement.step() ? statement.column_int(0) : 0;
+}
+
+std::int64_t JobStore::stored_bytes(const std::string& owner) {
+  std::lock_guard lock(m_store.mutex());
+  Statement statement = m_store.database().prepare(SELECT_STORED_BYTES);
+  statement.bind(1, owner).bind(2, owner).bind(3, owner);
+  return statement.step() ? statement.column_int64(0) : 0;
 }
 
 std::optional<ResultRecord> JobStore::result(std::int64_t row_id) {

@@ -104,6 +104,9 @@ class JobStore {
   /// Number of progress checkpoints of a job.
   int progress_count(std::int64_t row_id);
 
+  /// Bytes the owner's jobs take in the store: specs, results and progress checkpoints (shapes included).
+  std::int64_t stored_bytes(const std::string& owner);
+
   /// The stored result of a completed job.
   std::optional<ResultRecord> result(std::int64_t row_id);
 

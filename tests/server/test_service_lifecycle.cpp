@@ -5,6 +5,7 @@
 #include <signal.h>
 #include <sqlite3.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -206,6 +207,86 @@ TEST(ServiceLifecycle, ARepeatedRequestIdReturnsTheFirstJobAndStoresNothing) {
   const grpc::Status refused = submit(*stub, request, &repeat, "token-alice-0123456789");
   EXPECT_EQ(refused.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_NE(refused.error_message().find("request_id"), std::string::npos) << refused.error_message();
+}
+
+TEST(ServiceLifecycle, ATenantOverAQuotaGetsResourceExhaustedNamingIt) {
+  ScratchDir scratch;
+  const std::string tokens = scratch.file("tokens.txt");
+  const std::string alice = "token-alice-0123456789", bob = "token-bob-0123456789ab", carol = "token-carol-0123456789";
+  std::ofstream(tokens) << "alice " << alice << "\nbob " << bob << "\ncarol " << carol << "\n";
+  ServerProcess server(scratch.file("jobs.db"), {"--token-file", tokens, "--workers", "1", "--max-queued-per-tenant", "2",
+                                                 "--max-watches-per-tenant", "1", "--max-stored-mb-per-tenant", "1"});
+  auto stub = server.stub();
+  // The only worker is busy with alice's fit: everything below stays queued.
+  std::string blocker, job_id;
+  ASSERT_TRUE(submit(*stub, slow_fit_request(), &blocker, alice).ok());
+  ASSERT_EQ(wait_for(*stub, blocker, v1::JOB_STATE_RUNNING, 30, alice).state(), v1::JOB_STATE_RUNNING);
+  ASSERT_TRUE(submit(*stub, simulate_request(2, 2.0), &job_id, alice).ok());
+  ASSERT_TRUE(submit(*stub, simulate_request(2, 2.0), &job_id, alice).ok());
+  grpc::Status status = submit(*stub, simulate_request(2, 2.0), &job_id, alice);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_NE(status.error_message().find("max-queued-per-tenant"), std::string::npos) << status.error_message();
+  EXPECT_TRUE(submit(*stub, simulate_request(2, 2.0), &job_id, bob).ok()) << "bob has his own quota";
+
+  // Watches: one open stream per tenant here.
+  {
+    grpc::ClientContext first_context;
+    add_token(first_context, alice);
+    v1::WatchJobRequest request;
+    request.set_job_id(blocker);
+    auto first = stub->WatchJob(&first_context, request);
+    v1::JobEvent event;
+    ASSERT_TRUE(first->Read(&event));
+    grpc::ClientContext second_context;
+    add_token(second_context, alice);
+    auto second = stub->WatchJob(&second_context, request);
+    while (second->Read(&event)) {
+    }
+    status = second->Finish();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+    EXPECT_NE(status.error_message().find("max-watches-per-tenant"), std::string::npos) << status.error_message();
+    first_context.TryCancel();
+    first->Finish();
+  }
+
+  // Stored bytes: carol's first big mesh fits in 1 MiB, the second does not.
+  const v1::SubmitJobRequest big = simulate_request(5, 2.0);
+  ASSERT_GT(big.ByteSizeLong(), 600u * 1024);
+  ASSERT_TRUE(submit(*stub, big, &job_id, carol).ok());
+  status = submit(*stub, big, &job_id, carol);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_NE(status.error_message().find("max-stored-mb-per-tenant"), std::string::npos) << status.error_message();
+}
+
+TEST(ServiceLifecycle, TenantsTakeTurnsWhateverOrderTheySubmittedIn) {
+  ScratchDir scratch;
+  const std::string tokens = scratch.file("tokens.txt");
+  const std::string alice = "token-alice-0123456789", bob = "token-bob-0123456789ab";
+  std::ofstream(tokens) << "alice " << alice << "\nbob " << bob << "\n";
+  ServerProcess server(scratch.file("jobs.db"), {"--token-file", tokens, "--workers", "1"});
+  auto stub = server.stub();
+  std::string blocker;
+  ASSERT_TRUE(submit(*stub, slow_fit_request(), &blocker, alice).ok());
+  ASSERT_EQ(wait_for(*stub, blocker, v1::JOB_STATE_RUNNING, 30, alice).state(), v1::JOB_STATE_RUNNING);
+  // alice queues three jobs, then bob two, while the worker is busy.
+  std::vector<std::pair<std::string, std::string>> jobs;  // (job id, token)
+  for (const std::string* token : {&alice, &alice, &alice, &bob, &bob}) {
+    std::string job_id;
+    ASSERT_TRUE(submit(*stub, simulate_request(2, 2.0), &job_id, *token).ok());
+    jobs.emplace_back(job_id, *token);
+  }
+  ASSERT_TRUE(cancel(*stub, blocker, alice).ok());
+  std::vector<std::pair<std::int64_t, std::string>> started;  // (started_ms, tenant)
+  for (const auto& [job_id, token] : jobs) {
+    const v1::Job job = wait_for(*stub, job_id, v1::JOB_STATE_COMPLETED, 30, token);
+    ASSERT_EQ(job.state(), v1::JOB_STATE_COMPLETED);
+    started.emplace_back(job.started_ms(), token == alice ? "alice" : "bob");
+  }
+  std::sort(started.begin(), started.end());
+  std::vector<std::string> order;
+  for (const auto& entry : started) order.push_back(entry.second);
+  // alice's fit was the last served: bob's turn comes first, then they alternate until bob has none.
+  EXPECT_EQ(order, (std::vector<std::string>{"bob", "alice", "bob", "alice", "alice"}));
 }
 
 }  // namespace
