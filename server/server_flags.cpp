@@ -108,7 +108,7 @@ std::string server_usage() {
          "                           times) FAILS instead of running again; 0 no limit [3]\n"
          "  --max-queued-per-tenant N   queued jobs per tenant; more get RESOURCE_EXHAUSTED; 0 no limit [100]\n"
          "  --max-running-per-tenant N  jobs of one tenant running at once; 0 no limit [4]\n"
-         "  --max-watches-per-tenant N  open watch streams per tenant; 0 no limit [16]\n"
+         "  --max-watches-per-tenant N  open watch streams per tenant; 0 no limit [64]\n"
          "  --max-stored-mb-per-tenant N  MiB of jobs and results a tenant may store; 0 no limit [2048]\n"
          "  --retention-days D       delete finished jobs older than D days, at start and hourly; 0 keeps\n"
          "                           them forever [90]\n"

@@ -81,7 +81,13 @@ Result<std::unique_ptr<ServiceConnection>> ServiceConnection::open(const Connect
     config.service.db_path = options.db.empty() ? default_database_path() : options.db;
     config.service.run_jobs = options.run_jobs;
     config.service.workers = 0;  // number of cores
-    // The embedded server serves one user on this machine: no limits beyond the defaults' sanity.
+    // The embedded server serves one user on this machine: no limits beyond the defaults' sanity, no
+    // tenant quotas, and the user's history is never deleted behind their back (no retention).
+    config.service.max_queued_per_tenant = 0;
+    config.service.max_running_per_tenant = 0;
+    config.service.max_watches_per_tenant = 0;
+    config.service.max_stored_mb_per_tenant = 0;
+    config.service.retention_days = 0.0;
     std::error_code ignored;
     const std::filesystem::path parent = std::filesystem::path(config.service.db_path).parent_path();
     if (!parent.empty()) std::filesystem::create_directories(parent, ignored);

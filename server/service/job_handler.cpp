@@ -25,6 +25,7 @@ constexpr int DEFAULT_PAGE_SIZE = 100;
 constexpr double SHAPE_CHECKPOINT_INTERVAL_S = 1.0;  // stored shapes are big: at most one a second per job
 constexpr int FAIL_WRITE_ATTEMPTS = 3;
 constexpr std::size_t MAX_REQUEST_ID_LENGTH = 128;
+constexpr std::chrono::hours RETENTION_INTERVAL{1};  // how often old finished jobs are deleted
 constexpr std::int64_t REQUEST_ID_WINDOW_MS = 24LL * 3600 * 1000;  // a repeat within 24 h returns the first job
 
 /// Empty when `request_id` is a usable idempotency key, else the problem.
@@ -126,6 +127,10 @@ int JobHandler::start() {
   }
   if (m_lock_fd >= 0 && sole_user) ::flock(m_lock_fd, LOCK_SH);  // let other processes share the store now
   m_pool.start(m_options.workers);
+  if (m_options.retention_days > 0.0 && sole_user) {
+    apply_retention();
+    m_retention = std::thread([this] { retention_loop(); });
+  }
   return recovered;
 }
 
@@ -316,6 +321,38 @@ ServiceStatus JobHandler::cancel(const Caller& caller, const v1::CancelJobReques
   return ServiceStatus::success();
 }
 
+ServiceStatus JobHandler::remove(const Caller& caller, const v1::DeleteJobRequest& request, v1::DeleteJobResponse*) {
+  const auto record = find_owned(caller, request.job_id());
+  if (!record) return ServiceStatus::error(StatusCode::NotFound, "no job '" + request.job_id() + "'");
+  if (!store::is_terminal(record->state) || !m_jobs.delete_finished(record->row_id))
+    return ServiceStatus::error(StatusCode::FailedPrecondition,
+                                "job " + record->job_id + " is " + store::to_string(record->state) +
+                                    "; cancel it before deleting it");
+  log("job " + record->job_id + " deleted by its owner");
+  return ServiceStatus::success();
+}
+
+void JobHandler::apply_retention() {
+  const std::int64_t cutoff = now_ms() - static_cast<std::int64_t>(m_options.retention_days * 86400e3);
+  try {
+    const int deleted = m_jobs.delete_finished_before(cutoff);
+    if (deleted > 0)
+      log("retention: deleted " + std::to_string(deleted) + " job(s) finished more than " +
+          format_number(m_options.retention_days) + " days ago");
+  } catch (const std::exception& error) {
+    log(std::string("retention: could not delete old jobs: ") + error.what());
+  }
+}
+
+void JobHandler::retention_loop() {
+  std::unique_lock lock(m_retention_mutex);
+  while (!m_retention_wake.wait_for(lock, RETENTION_INTERVAL, [this] { return m_retention_stop; })) {
+    lock.unlock();
+    apply_retention();
+    lock.lock();
+  }
+}
+
 ServiceStatus JobHandler::watch(const Caller& caller, const v1::WatchJobRequest& request,
                                 std::shared_ptr<WatchChannel>* channel) {
   if (m_pool.stopping()) return ServiceStatus::error(StatusCode::Unavailable, "the server is shutting down");
@@ -501,6 +538,12 @@ void JobHandler::finish_stopped(const store::JobRecord& record, const ActiveJob&
 }
 
 void JobHandler::shutdown() {
+  {
+    std::lock_guard lock(m_retention_mutex);
+    m_retention_stop = true;
+  }
+  m_retention_wake.notify_all();
+  if (m_retention.joinable()) m_retention.join();
   m_pool.shutdown();
   m_watches.close_all(ServiceStatus::error(StatusCode::Unavailable, "the server is shutting down"));
   if (m_lock_fd >= 0) {

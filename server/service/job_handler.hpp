@@ -47,6 +47,10 @@ class JobHandler {
                      balloon::v1::ListJobsResponse* reply);
   /// Queued: removed at once. Running: stopped within one solver iteration; the state is CANCELLED at once.
   ServiceStatus cancel(const Caller& caller, const balloon::v1::CancelJobRequest& request, balloon::v1::Job* reply);
+  /// Deletes a finished job of the caller with its result. FAILED_PRECONDITION for a queued or running
+  /// job (cancel it first), NOT_FOUND for a missing job or another tenant's.
+  ServiceStatus remove(const Caller& caller, const balloon::v1::DeleteJobRequest& request,
+                       balloon::v1::DeleteJobResponse* reply);
   /// Opens a channel that receives the job's current state, then its events until it finishes.
   ServiceStatus watch(const Caller& caller, const balloon::v1::WatchJobRequest& request,
                       std::shared_ptr<WatchChannel>* channel);
@@ -74,6 +78,9 @@ class JobHandler {
   /// Records a job that stopped early: cancelled (already stored), timed out, or re-queued at shutdown.
   void finish_stopped(const store::JobRecord& record, const ActiveJob& active);
   bool acquire_store_lock();
+  /// Deletes finished jobs older than retention_days (at start, then hourly on its own thread).
+  void apply_retention();
+  void retention_loop();
 
   void fill_job(const store::JobRecord& record, balloon::v1::Job* job) const;
   std::optional<store::JobRecord> find_owned(const Caller& caller, const std::string& job_id);
@@ -87,6 +94,11 @@ class JobHandler {
   JobQueue m_queue;
   WatchHub m_watches;
   WorkerPool m_pool;
+
+  std::thread m_retention;
+  std::mutex m_retention_mutex;
+  std::condition_variable m_retention_wake;
+  bool m_retention_stop = false;
 
   bool m_started = false;
   int m_lock_fd = -1;

@@ -18,7 +18,7 @@ struct ServiceOptions {
   int max_attempts = 3;                 ///< a job found running at start after this many starts FAILS; 0 no limit
   int max_queued_per_tenant = 100;      ///< queued jobs per tenant; more get RESOURCE_EXHAUSTED; 0 no limit
   int max_running_per_tenant = 4;       ///< jobs of one tenant running at once (others wait their turn); 0 no limit
-  int max_watches_per_tenant = 16;      ///< open watch streams per tenant; more get RESOURCE_EXHAUSTED; 0 no limit
+  int max_watches_per_tenant = 64;      ///< open watch streams per tenant; more get RESOURCE_EXHAUSTED; 0 no limit
   int max_stored_mb_per_tenant = 2048;  ///< MiB of specs and results a tenant may store; 0 no limit
   double retention_days = 90.0;         ///< finished jobs older than this are deleted (days); 0 keeps them forever
   bool run_jobs = true;                 ///< false: accept and store jobs but start no workers (a short-lived CLI)

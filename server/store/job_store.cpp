@@ -57,6 +57,10 @@ constexpr const char* INSERT_PROGRESS =
     "max_error_mm, recorded_ms, shape) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)";
 constexpr const char* SELECT_LATEST_SHAPE =
     "SELECT shape FROM progress WHERE job_row = ? AND shape IS NOT NULL ORDER BY id DESC LIMIT 1";
+constexpr const char* DELETE_FINISHED_JOB =
+    "DELETE FROM jobs WHERE id = ? AND state IN ('completed', 'failed', 'cancelled')";
+constexpr const char* DELETE_FINISHED_BEFORE =
+    "DELETE FROM jobs WHERE state IN ('completed', 'failed', 'cancelled') AND finished_ms < ?";
 // length() of a BLOB reads its size, not its bytes.
 constexpr const char* SELECT_STORED_BYTES =
     "SELECT (SELECT COALESCE(SUM(LENGTH(spec) + LENGTH(summary) + LENGTH(error)), 0) FROM jobs WHERE owner = ?) + "
@@ -259,6 +263,18 @@ int JobStore::progress_count(std::int64_t row_id) {
   Statement statement = m_store.database().prepare(COUNT_PROGRESS);
   statement.bind(1, row_id);
   return statement.step() ? statement.column_int(0) : 0;
+}
+
+bool JobStore::delete_finished(std::int64_t row_id) {
+  std::lock_guard lock(m_store.mutex());
+  m_store.database().prepare(DELETE_FINISHED_JOB).bind(1, row_id).run();
+  return m_store.database().changes() == 1;
+}
+
+int JobStore::delete_finished_before(std::int64_t cutoff_ms) {
+  std::lock_guard lock(m_store.mutex());
+  m_store.database().prepare(DELETE_FINISHED_BEFORE).bind(1, cutoff_ms).run();
+  return m_store.database().changes();
 }
 
 std::int64_t JobStore::stored_bytes(const std::string& owner) {

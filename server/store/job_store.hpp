@@ -104,6 +104,13 @@ class JobStore {
   /// Number of progress checkpoints of a job.
   int progress_count(std::int64_t row_id);
 
+  /// Deletes a finished job with its result and progress (ON DELETE CASCADE). False, deleting nothing, if
+  /// the job is queued or running (or gone).
+  bool delete_finished(std::int64_t row_id);
+  /// Deletes every finished job that finished before `cutoff_ms` (ms since the epoch), with its result
+  /// and progress. Returns how many.
+  int delete_finished_before(std::int64_t cutoff_ms);
+
   /// Bytes the owner's jobs take in the store: specs, results and progress checkpoints (shapes included).
   std::int64_t stored_bytes(const std::string& owner);
 

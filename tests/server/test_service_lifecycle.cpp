@@ -289,5 +289,68 @@ TEST(ServiceLifecycle, TenantsTakeTurnsWhateverOrderTheySubmittedIn) {
   EXPECT_EQ(order, (std::vector<std::string>{"bob", "alice", "bob", "alice", "alice"}));
 }
 
+TEST(ServiceLifecycle, DeleteJobRemovesAFinishedJobWithItsResultAndIsFencedByTenant) {
+  ScratchDir scratch;
+  const std::string tokens = scratch.file("tokens.txt");
+  const std::string alice = "token-alice-0123456789", bob = "token-bob-0123456789ab";
+  std::ofstream(tokens) << "alice " << alice << "\nbob " << bob << "\n";
+  ServerProcess server(scratch.file("jobs.db"), {"--token-file", tokens, "--workers", "1"});
+  auto stub = server.stub();
+  const auto delete_job = [&](const std::string& job_id, const std::string& token) {
+    grpc::ClientContext context;
+    add_token(context, token);
+    v1::DeleteJobRequest request;
+    request.set_job_id(job_id);
+    v1::DeleteJobResponse reply;
+    return stub->DeleteJob(&context, request, &reply);
+  };
+  std::string finished, running;
+  ASSERT_TRUE(submit(*stub, simulate_request(2, 2.0), &finished, alice).ok());
+  ASSERT_EQ(wait_for(*stub, finished, v1::JOB_STATE_COMPLETED, 30, alice).state(), v1::JOB_STATE_COMPLETED);
+  // Another tenant cannot delete it, nor learn that it exists.
+  grpc::Status status = delete_job(finished, bob);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+  v1::Job job;
+  EXPECT_TRUE(get_job(*stub, finished, &job, alice).ok());
+  // A running job must be cancelled first.
+  ASSERT_TRUE(submit(*stub, slow_fit_request(), &running, alice).ok());
+  ASSERT_EQ(wait_for(*stub, running, v1::JOB_STATE_RUNNING, 30, alice).state(), v1::JOB_STATE_RUNNING);
+  status = delete_job(running, alice);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_NE(status.error_message().find("cancel it"), std::string::npos) << status.error_message();
+  ASSERT_TRUE(cancel(*stub, running, alice).ok());
+  EXPECT_TRUE(delete_job(running, alice).ok());
+  // The owner deletes it: the job and its result are gone.
+  ASSERT_TRUE(delete_job(finished, alice).ok());
+  EXPECT_EQ(get_job(*stub, finished, &job, alice).error_code(), grpc::StatusCode::NOT_FOUND);
+  grpc::ClientContext context;
+  add_token(context, alice);
+  v1::GetResultRequest request;
+  request.set_job_id(finished);
+  v1::JobResult result;
+  EXPECT_EQ(stub->GetResult(&context, request, &result).error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(delete_job(finished, alice).error_code(), grpc::StatusCode::NOT_FOUND);
+}
+
+TEST(ServiceLifecycle, RetentionDeletesFinishedJobsOlderThanItsDaysAtStart) {
+  ScratchDir scratch;
+  const std::string db = scratch.file("jobs.db");
+  std::string old_job, recent_job;
+  {
+    ServerProcess server(db, {"--workers", "1"});
+    auto stub = server.stub();
+    ASSERT_TRUE(submit(*stub, simulate_request(2, 2.0), &old_job).ok());
+    ASSERT_TRUE(submit(*stub, simulate_request(2, 2.0), &recent_job).ok());
+    ASSERT_EQ(wait_for(*stub, recent_job, v1::JOB_STATE_COMPLETED, 30).state(), v1::JOB_STATE_COMPLETED);
+  }
+  // The first finished 10 days ago.
+  run_sql(db, "UPDATE jobs SET finished_ms = finished_ms - 10 * 86400000 WHERE job_id = '" + old_job + "'");
+  ServerProcess restarted(db, {"--workers", "1", "--retention-days", "7"});
+  auto stub = restarted.stub();
+  v1::Job job;
+  EXPECT_EQ(get_job(*stub, old_job, &job).error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_TRUE(get_job(*stub, recent_job, &job).ok());
+}
+
 }  // namespace
 }  // namespace balloon::testing
