@@ -5,6 +5,7 @@
 
 #include "jobs/design_job.hpp"
 #include "mesh/mesh_checks.hpp"
+#include "mesh/mesh_geometry.hpp"
 #include "mesh/mesh_io.hpp"
 #include "service/job_kind.hpp"
 #include "store/mesh_blob.hpp"
@@ -23,6 +24,26 @@ struct DecodedDesign {
   Material material;
   jobs::DesignParameters parameters;
 };
+
+/// A nozzle centre that cannot be on the target's surface, found before remeshing: empty, or the message
+/// prepare_design gives on the worker. `target` is the checked (closed, manifold) mesh as uploaded.
+std::string nozzle_problem(TriMesh target, const jobs::DesignParameters& parameters) {
+  if (parameters.nozzle.empty()) return "";
+  const Result<NozzleSpec> nozzle = parse_nozzle(parameters.nozzle);
+  if (!nozzle || nozzle->automatic) return "";
+  if (parameters.size_mm > 0.0) target.vertices *= parameters.size_mm / bounding_box_diagonal(target.vertices);
+  // A point on the surface lies within one edge of a vertex; remeshing moves the vertices, not the
+  // surface. So only a centre farther than the longest edge is judged now, by the worker's own rule.
+  double longest_edge = 0.0;
+  for (int f = 0; f < target.face_count(); ++f)
+    for (int k = 0; k < 3; ++k)
+      longest_edge = std::max(longest_edge, (target.vertices.row(target.faces(f, k)) -
+                                             target.vertices.row(target.faces(f, (k + 1) % 3))).norm());
+  const double gap = (target.vertices.rowwise() - nozzle->center.transpose()).rowwise().norm().minCoeff();
+  if (gap <= longest_edge) return "";
+  const Result<NozzleSelection> selection = select_nozzle(target, *nozzle);
+  return selection ? "" : "nozzle: " + selection.error();
+}
 
 /// Decodes and checks a design job: the mesh (within `max_vertices`), the material and the parameters.
 /// Cheap: the target is read and, with `check_mesh`, checked closed and manifold, but not remeshed.
@@ -72,6 +93,8 @@ ServiceStatus decode_design(const v1::DesignJob& job, const std::string& tenant,
     TriMesh checked = *mesh;
     if (Result<MeshCheckReport> report = validate_balloon_mesh(checked); !report)
       return ServiceStatus::error(StatusCode::InvalidArgument, "target_mesh: target mesh: " + report.error());
+    if (const std::string problem = nozzle_problem(std::move(checked), parameters); !problem.empty())
+      return ServiceStatus::error(StatusCode::InvalidArgument, problem);
   }
   decoded->target = std::move(*mesh);
   decoded->material = std::move(*material);
