@@ -35,11 +35,14 @@ class JobHandler {
   JobHandler(const JobHandler&) = delete;
   JobHandler& operator=(const JobHandler&) = delete;
 
-  /// Re-queues unfinished jobs from the store (when this process is the store's only user) and starts
-  /// the workers. Returns the number of jobs recovered.
+  /// Re-queues unfinished jobs from the store (when this process is the store's only user; a job that
+  /// already started max_attempts times FAILS instead), applies the retention and starts the workers.
+  /// Returns the number of jobs recovered.
   int start();
 
-  /// Checks the job (mesh, material, options) and returns once it is stored and queued.
+  /// Checks the queue and the caller's quotas, then the job (mesh, material, options; cheap checks only:
+  /// no remeshing), and returns once it is stored and queued. A request_id the caller used within 24 h
+  /// returns that first job instead.
   ServiceStatus submit(const Caller& caller, const balloon::v1::SubmitJobRequest& request,
                        balloon::v1::SubmitJobResponse* reply);
   ServiceStatus get(const Caller& caller, const balloon::v1::GetJobRequest& request, balloon::v1::Job* reply);
