@@ -26,6 +26,9 @@ const std::map<std::string, bool>& known_flags() {
       {"http", true},         {"web-root", true},       {"http-allowed-origin", true},
       {"http-tls-cert", true}, {"http-tls-key", true},   {"http-max-event-streams", true},
       {"insecure-plaintext-tokens", false},
+      // Job lifecycle and tenant quotas (README, "Service guarantees").
+      {"max-attempts", true}, {"max-queued-per-tenant", true}, {"max-running-per-tenant", true},
+      {"max-watches-per-tenant", true}, {"max-stored-mb-per-tenant", true}, {"retention-days", true},
   };
   return flags;
 }
@@ -122,6 +125,14 @@ std::string server_usage() {
          "  --insecure-listen-any    allow non-loopback --listen/--http addresses without a token file [off]\n"
          "  --insecure-plaintext-tokens  allow tokens over plaintext gRPC/HTTP on non-loopback addresses\n"
          "                           (e.g. behind a proxy that terminates TLS) [off]\n"
+         "  --max-attempts N         a job found running at start after N starts (it crashed the server N\n"
+         "                           times) FAILS instead of running again; 0 no limit [3]\n"
+         "  --max-queued-per-tenant N   queued jobs per tenant; more get RESOURCE_EXHAUSTED; 0 no limit [100]\n"
+         "  --max-running-per-tenant N  jobs of one tenant running at once; 0 no limit [4]\n"
+         "  --max-watches-per-tenant N  open watch streams per tenant; 0 no limit [64]\n"
+         "  --max-stored-mb-per-tenant N  MiB of jobs and results a tenant may store; 0 no limit [2048]\n"
+         "  --retention-days D       delete finished jobs older than D days, at start and hourly; 0 keeps\n"
+         "                           them forever [90]\n"
          "  --quiet                  no per-job log lines on stderr [off]\n"
          "  --config FILE            read 'name = value' settings first (names as the flags) [none]\n"
          "  --help                   this text\n\n"
@@ -209,6 +220,23 @@ Result<ServerCommand> parse_server_flags(const std::vector<std::string>& args) {
       Result<double> s = to_number(name, value);
       if (!s) return fail(s.error());
       config.service.job_time_limit_s = *s;
+    } else if (name == "max-attempts" || name == "max-queued-per-tenant" || name == "max-running-per-tenant" ||
+               name == "max-watches-per-tenant" || name == "max-stored-mb-per-tenant") {
+      Result<long long> n = to_integer(name, value, 0, 10000000);
+      if (!n) return fail(n.error());
+      balloon::service::ServiceOptions& service = config.service;
+      int& target = name == "max-attempts"             ? service.max_attempts
+                    : name == "max-queued-per-tenant"  ? service.max_queued_per_tenant
+                    : name == "max-running-per-tenant" ? service.max_running_per_tenant
+                    : name == "max-watches-per-tenant" ? service.max_watches_per_tenant
+                                                       : service.max_stored_mb_per_tenant;
+      target = static_cast<int>(*n);
+    } else if (name == "retention-days") {
+      char* end = nullptr;
+      const double days = std::strtod(value.c_str(), &end);
+      if (value.empty() || *end != '\0' || !std::isfinite(days) || days < 0.0 || days > 1e6)
+        return fail("--retention-days: '" + value + "' is not a number of days within 0..1000000");
+      config.service.retention_days = days;
     } else if (name == "progress-mesh-every") {
       Result<long long> n = to_integer(name, value, -1, 1000000);
       if (!n) return fail(n.error());

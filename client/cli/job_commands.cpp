@@ -1,4 +1,4 @@
-/// `balloon submit` and `balloon jobs list|show|watch|cancel|result`: the job queue from the command line.
+/// `balloon submit` and `balloon jobs list|show|watch|cancel|delete|result`: the job queue from the command line.
 #include <google/protobuf/util/json_util.h>
 #include <unistd.h>
 
@@ -34,12 +34,14 @@ constexpr const char* JOBS_HELP =
     "       balloon jobs show ID [--json]\n"
     "       balloon jobs watch ID [--json]\n"
     "       balloon jobs cancel ID [--json]\n"
+    "       balloon jobs delete ID\n"
     "       balloon jobs result ID --out-dir DIR [--format obj|stl|ply] [--json]\n\n"
     "  list     your jobs, newest first; STATE: queued, running, completed, failed, cancelled\n"
     "  show     one job: state, summary, progress, timestamps\n"
     "  watch    follow a job until it ends (progress on stderr; --json: one event per line on stdout).\n"
     "           Ctrl-C stops watching and leaves the job running\n"
     "  cancel   cancel a queued or running job\n"
+    "  delete   delete a finished job and its result (cancel a queued or running one first)\n"
     "  result   write rest.EXT, inflated.EXT and report.json of a completed job into DIR\n\n"
     "Exit codes: 0 ok, 2 bad input, 3 (watch/result) finished without converging, 4 no such job,\n"
     "5 unreachable, 6 not allowed, 7 no result yet, 8 the job failed or was cancelled, 130 Ctrl-C.\n\n";
@@ -181,8 +183,10 @@ int run_jobs_command(const std::vector<std::string>& args) {
   }
   const bool json = parsed->has("json");
   const bool needs_id = action != "list";
-  if (action != "list" && action != "show" && action != "watch" && action != "cancel" && action != "result")
-    return report_error("jobs", "unknown action '" + action + "' (list, show, watch, cancel, result)", EXIT_BAD_INPUT);
+  if (action != "list" && action != "show" && action != "watch" && action != "cancel" && action != "delete" &&
+      action != "result")
+    return report_error("jobs", "unknown action '" + action + "' (list, show, watch, cancel, delete, result)",
+                        EXIT_BAD_INPUT);
   if (needs_id && parsed->positionals.size() != 1) return report_error(command, "expected one job ID", EXIT_BAD_INPUT);
   if (!needs_id && !parsed->positionals.empty())
     return report_error(command, "unexpected argument '" + parsed->positionals.front() + "'", EXIT_BAD_INPUT);
@@ -224,6 +228,21 @@ int run_jobs_command(const std::vector<std::string>& args) {
                     format_time(job.created_ms()).c_str(), job.summary().c_str());
       if (reply.jobs().empty()) std::printf("no jobs\n");
     }
+    return EXIT_OK;
+  }
+
+  if (action == "delete") {
+    grpc::ClientContext context;
+    service.prepare(context);
+    v1::DeleteJobRequest request;
+    request.set_job_id(job_id);
+    v1::DeleteJobResponse reply;
+    const grpc::Status status = service.stub().DeleteJob(&context, request, &reply);
+    if (!status.ok()) return report_error(command, status.error_message(), exit_code_for(status));
+    if (json)
+      std::cout << "{\"deleted\":\"" << job_id << "\"}" << std::endl;
+    else
+      std::printf("deleted %s\n", job_id.c_str());
     return EXIT_OK;
   }
 

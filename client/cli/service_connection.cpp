@@ -1,10 +1,13 @@
 #include "service_connection.hpp"
 
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
+#include <thread>
 
 #include "exit_codes.hpp"
 #include "rpc/grpc_server.hpp"
@@ -78,7 +81,13 @@ Result<std::unique_ptr<ServiceConnection>> ServiceConnection::open(const Connect
     config.service.db_path = options.db.empty() ? default_database_path() : options.db;
     config.service.run_jobs = options.run_jobs;
     config.service.workers = 0;  // number of cores
-    // The embedded server serves one user on this machine: no limits beyond the defaults' sanity.
+    // The embedded server serves one user on this machine: no limits beyond the defaults' sanity, no
+    // tenant quotas, and the user's history is never deleted behind their back (no retention).
+    config.service.max_queued_per_tenant = 0;
+    config.service.max_running_per_tenant = 0;
+    config.service.max_watches_per_tenant = 0;
+    config.service.max_stored_mb_per_tenant = 0;
+    config.service.retention_days = 0.0;
     std::error_code ignored;
     const std::filesystem::path parent = std::filesystem::path(config.service.db_path).parent_path();
     if (!parent.empty()) std::filesystem::create_directories(parent, ignored);
@@ -102,11 +111,38 @@ void ServiceConnection::prepare(grpc::ClientContext& context) const {
   if (!m_token.empty()) context.AddMetadata("authorization", "Bearer " + m_token);
 }
 
+namespace {
+
+/// Tries of one submission when the server cannot be reached (a lost reply included).
+constexpr int SUBMIT_TRIES = 3;
+
+/// 128 random bits as 32 hex digits: the submission's idempotency key.
+std::string new_request_id() {
+  std::random_device device;
+  char buffer[40];
+  std::snprintf(buffer, sizeof(buffer), "%08x%08x%08x%08x", device(), device(), device(), device());
+  return buffer;
+}
+
+}  // namespace
+
 grpc::Status ServiceConnection::submit(const balloon::v1::SubmitJobRequest& request,
                                        balloon::v1::SubmitJobResponse* reply) {
-  grpc::ClientContext context;
-  prepare(context);
-  return m_stub->SubmitJob(&context, request, reply);
+  // One request id per submission, reused by its retries: a reply lost on the way back must not leave
+  // a second job behind (the server returns the first job for a repeated id).
+  balloon::v1::SubmitJobRequest sent = request;
+  if (sent.request_id().empty()) sent.set_request_id(new_request_id());
+  grpc::Status status;
+  for (int attempt = 1; attempt <= SUBMIT_TRIES; ++attempt) {
+    grpc::ClientContext context;
+    prepare(context);
+    status = m_stub->SubmitJob(&context, sent, reply);
+    if (status.error_code() != grpc::StatusCode::UNAVAILABLE &&
+        status.error_code() != grpc::StatusCode::DEADLINE_EXCEEDED)
+      break;
+    if (attempt < SUBMIT_TRIES) std::this_thread::sleep_for(std::chrono::milliseconds(250 * attempt));
+  }
+  return status;
 }
 
 std::string message_naming_file(const grpc::Status& status, const std::string& field, const std::string& path) {

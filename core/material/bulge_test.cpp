@@ -348,7 +348,7 @@ double BulgeResponse::pressure_at(double x) const {
 }
 
 BulgeResponse fem_bulge_response(const Material& material, double radius_mm, double thickness_mm,
-                                 double max_extension_ratio, int rings) {
+                                 double max_extension_ratio, int rings, const CancelToken* cancel) {
   BulgeResponse response;
   response.extension_ratio = {1.0};
   response.pressure_kpa = {0.0};
@@ -363,6 +363,7 @@ BulgeResponse fem_bulge_response(const Material& material, double radius_mm, dou
   std::string message;
   double rho_guess = FIRST_EXTENSION_RATIO;
   for (int k = 0; k < 300 && response.extension_ratio.back() < max_extension_ratio; ++k) {
+    if (cancel != nullptr && cancel->cancelled()) break;
     const double volume =
         std::max(bulge_cap_volume(radius_mm, rho_guess), run.started() ? 1.0001 * run.volume() : 0.0);
     if (!run.advance_to_volume(volume, message)) break;
@@ -414,12 +415,16 @@ Result<FitResult> fit_material_with_fem_bulge(MaterialModel model, const std::ve
   double last_mismatch = std::numeric_limits<double>::infinity();
   std::string trace;
   Material at = fit->material;  // where the FEM correction is computed
+  const auto cancelled = [&options] { return options.cancel != nullptr && options.cancel->cancelled(); };
   for (int round = 0; round < max_rounds; ++round) {
+    if (cancelled()) return fail(FIT_CANCELLED);
     for (size_t s = 0; s < sets.size(); ++s) {
       if (sets[s].kind != TestKind::Bulge) continue;
       // Past the last measured ratio so the regime grid and plots stay inside the sweep.
       const double x_max = *std::max_element(sets[s].x.begin(), sets[s].x.end());
-      corrections[s] = {fem_bulge_response(at, sets[s].disc_radius_mm, sets[s].thickness_mm, x_max + 0.02, rings), at};
+      corrections[s] = {fem_bulge_response(at, sets[s].disc_radius_mm, sets[s].thickness_mm, x_max + 0.02, rings,
+                                         options.cancel),
+                      at};
     }
     corrected.bulge_model = [&sets, &corrections, same_geometry](const Material& material, const MeasurementSet& query) {
       std::vector<double> p = spherical_cap_bulge_pressures(material, query);
@@ -435,6 +440,7 @@ Result<FitResult> fit_material_with_fem_bulge(MaterialModel model, const std::ve
       }
       return p;
     };
+    if (cancelled()) return fail(FIT_CANCELLED);  // a sweep cut short is no correction
     fit = fit_material(model, sets, corrected);
     if (!fit) return fit;
     // The corrected model equals the FEM at `at`; if the new optimum predicts the same pressures as `at`

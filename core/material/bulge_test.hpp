@@ -82,9 +82,9 @@ struct BulgeResponse {
 };
 
 /// Volume-controlled sweep from the flat disc in steps of about 0.02 in extension ratio (estimated from the
-/// spherical cap) until `max_extension_ratio` is passed or the sweep fails.
+/// spherical cap) until `max_extension_ratio` is passed, the sweep fails or `cancel` (may be null) fires.
 BulgeResponse fem_bulge_response(const Material& material, double radius_mm, double thickness_mm,
-                                 double max_extension_ratio, int rings = 6);
+                                 double max_extension_ratio, int rings = 6, const CancelToken* cancel = nullptr);
 
 /// Pressures (kPa) of the FEM bulge test at each extension ratio of `set` (a Bulge set), interpolated
 /// linearly in a volume-controlled sweep that runs past the largest measured ratio; NaN where the sweep
@@ -102,7 +102,8 @@ BulgeModel fem_bulge_model(int rings = 6);
 /// measured pressure (at most `max_rounds` refits; the message says which). The reported residuals are
 /// then FEM residuals. The search neglects how c depends on the material, so along a flat valley of the
 /// cost (G against k2 for Hart-Smith) it can stop at a point a little off the FEM least-squares optimum.
-/// Sets of other kinds are fitted as by fit_material. `options.bulge_model` is ignored.
+/// Sets of other kinds are fitted as by fit_material. `options.bulge_model` is ignored; `options.cancel`
+/// is checked between rounds and sweep steps (the fit then fails with FIT_CANCELLED).
 Result<FitResult> fit_material_with_fem_bulge(MaterialModel model, const std::vector<MeasurementSet>& sets,
                                               const FitOptions& options = {}, int rings = 16, int max_rounds = 10);
 

@@ -54,6 +54,8 @@ struct Problem {
   std::vector<std::vector<double>> weights;  // per set, per point: 1 / max(|y|, floor)
   int points = 0;
 
+  bool cancelled() const { return options->cancel != nullptr && options->cancel->cancelled(); }
+
   std::vector<double> model_y(const Material& m, size_t s) const {
     const auto& set = (*sets)[s];
     return model_values(m, set, set.x, *options);
@@ -82,11 +84,13 @@ struct LmFunctor {
   int inputs() const { return parameter_count(problem->model); }
   int values() const { return problem->points; }
   int operator()(const Eigen::VectorXd& q, Eigen::VectorXd& fvec) const {
+    if (problem->cancelled()) return -1;  // Levenberg-Marquardt stops with UserAsked
     ++*evaluations;
     fvec = problem->residuals(material_from_variables(problem->model, q));
     return 0;
   }
   int df(const Eigen::VectorXd& q, Eigen::MatrixXd& fjac) const {
+    if (problem->cancelled()) return -1;
     fjac.resize(values(), inputs());
     for (int j = 0; j < q.size(); ++j) {
       const double h = 1e-6 * std::max(1.0, std::abs(q[j]));
@@ -312,6 +316,7 @@ Result<FitResult> fit_material(MaterialModel model, const std::vector<Measuremen
   Material best = candidates.front().first;
   int best_status = -1;
   for (const auto& candidate : candidates) {
+    if (problem.cancelled()) return fail(FIT_CANCELLED);
     Eigen::VectorXd q = variables_from_material(candidate.first);
     Eigen::LevenbergMarquardt<LmFunctor> lm(functor);
     lm.parameters.maxfev = options.max_evaluations;
@@ -325,6 +330,7 @@ Result<FitResult> fit_material(MaterialModel model, const std::vector<Measuremen
       best_status = status;
     }
   }
+  if (problem.cancelled()) return fail(FIT_CANCELLED);
   result.material = best;
   result.converged = best_status >= 1 && best_status <= 8 && best_status != 5;
   std::ostringstream message;

@@ -8,6 +8,7 @@
 
 #include "material/material.hpp"
 #include "material/measurements.hpp"
+#include "progress.hpp"
 #include "result.hpp"
 
 namespace balloon {
@@ -44,7 +45,13 @@ struct FitOptions {
   int max_evaluations = 2000;
   /// Points of the fine grid on which the fitted curve is evaluated for the regime report. Default 200.
   int regime_grid_points = 200;
+  /// Checked between residual evaluations (and FEM sweep steps); once it fires the fit stops and fails
+  /// with FIT_CANCELLED. May be null.
+  const CancelToken* cancel = nullptr;
 };
+
+/// The error of a fit stopped by its cancel token.
+inline constexpr const char* FIT_CANCELLED = "cancelled";
 
 /// Regimes of a curve y(x) sampled at increasing x (paper sec. 4.2). Slopes are least-squares slopes in
 /// windows a quarter of the x range wide, at 13 window positions spanning the range; with s_first, s_last

@@ -453,6 +453,11 @@ struct HttpGateway::Internals {
       request.set_job_id(req.matches[1]);
       unary(req, res, request, &Stub::CancelJob);
     }));
+    server->Delete(R"(/api/v1/jobs/([^/]+))", admitted([this](const httplib::Request& req, httplib::Response& res) {
+      v1::DeleteJobRequest request;
+      request.set_job_id(req.matches[1]);
+      unary(req, res, request, &Stub::DeleteJob);
+    }));
     server->Get(R"(/api/v1/jobs/([^/]+)/result)",
                admitted([this](const httplib::Request& req, httplib::Response& res) { get_result(req, res); }));
     server->Get(R"(/api/v1/jobs/([^/]+)/events)",

@@ -129,11 +129,14 @@ Result<FitInput> prepare_fit(const std::vector<FitDataFile>& files, const std::s
   return input;
 }
 
-Result<FitOutcome> run_fit(const FitInput& input) {
+Result<FitOutcome> run_fit(const FitInput& input, const CancelToken* cancel) {
   FitOutcome outcome;
   const double start = now_s();
+  FitOptions options;
+  options.cancel = cancel;
   for (MaterialModel model : input.models) {
-    Result<FitResult> fit = fit_material_with_fem_bulge(model, input.sets, FitOptions{}, FIT_BULGE_RINGS);
+    if (cancel != nullptr && cancel->cancelled()) return fail(FIT_CANCELLED);
+    Result<FitResult> fit = fit_material_with_fem_bulge(model, input.sets, options, FIT_BULGE_RINGS);
     if (!fit) return fail(model_name(model) + ": " + fit.error());
     outcome.fits.push_back(std::move(*fit));
   }

@@ -43,8 +43,9 @@ struct FitOutcome {
 
 /// Fits every model. Bulge sets use the FEM bulge simulation (core/material/bulge_test) through
 /// fit_material_with_fem_bulge (a spherical cap corrected by FEM sweeps at the current fit).
-/// Fails with a message when the data cannot be fitted (e.g. fewer points than parameters).
-Result<FitOutcome> run_fit(const FitInput& input);
+/// Fails with a message when the data cannot be fitted (e.g. fewer points than parameters), or with
+/// FIT_CANCELLED once `cancel` (may be null) fires: it is checked between iterations of every fit.
+Result<FitOutcome> run_fit(const FitInput& input, const CancelToken* cancel = nullptr);
 
 /// Index into outcome.fits of the best fit (smallest RMS relative residual).
 int best_fit_index(const FitOutcome& outcome);

@@ -168,6 +168,12 @@ grpc::Status BalloonServiceImpl::CancelJob(grpc::ServerContext* context, const v
               [this](auto& c, auto& q, auto* r) { return m_jobs.cancel(c, q, r); });
 }
 
+grpc::Status BalloonServiceImpl::DeleteJob(grpc::ServerContext* context, const v1::DeleteJobRequest* request,
+                                           v1::DeleteJobResponse* reply) {
+  return call("DeleteJob", context, request, reply,
+              [this](auto& c, auto& q, auto* r) { return m_jobs.remove(c, q, r); });
+}
+
 grpc::Status BalloonServiceImpl::GetResult(grpc::ServerContext* context, const v1::GetResultRequest* request,
                                            v1::JobResult* reply) {
   return call("GetResult", context, request, reply,

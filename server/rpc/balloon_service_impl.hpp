@@ -31,6 +31,8 @@ class BalloonServiceImpl final : public BalloonServiceBase {
                         balloon::v1::ListJobsResponse* reply) override;
   grpc::Status CancelJob(grpc::ServerContext* context, const balloon::v1::CancelJobRequest* request,
                          balloon::v1::Job* reply) override;
+  grpc::Status DeleteJob(grpc::ServerContext* context, const balloon::v1::DeleteJobRequest* request,
+                         balloon::v1::DeleteJobResponse* reply) override;
   grpc::ServerWriteReactor<balloon::v1::JobEvent>* WatchJob(grpc::CallbackServerContext* context,
                                                             const balloon::v1::WatchJobRequest* request) override;
   grpc::Status GetResult(grpc::ServerContext* context, const balloon::v1::GetResultRequest* request,

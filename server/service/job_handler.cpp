@@ -10,10 +10,8 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <thread>
 
-#include "jobs/design_job.hpp"
-#include "jobs/fit_job.hpp"
-#include "jobs/simulate_job.hpp"
 #include "mesh/mesh_io.hpp"
 #include "store/mesh_blob.hpp"
 
@@ -23,13 +21,23 @@ namespace {
 namespace v1 = balloon::v1;
 using store::JobState;
 
-constexpr const char* KIND_SIMULATE = "simulate";
-constexpr const char* KIND_DESIGN = "design";
-constexpr const char* KIND_FIT_MATERIAL = "fit_material";
 constexpr int MAX_PAGE_SIZE = 1000;
 constexpr int DEFAULT_PAGE_SIZE = 100;
 constexpr double SHAPE_CHECKPOINT_INTERVAL_S = 1.0;  // stored shapes are big: at most one a second per job
+constexpr int FAIL_WRITE_ATTEMPTS = 3;
+constexpr std::size_t MAX_REQUEST_ID_LENGTH = 128;
+constexpr std::chrono::hours RETENTION_INTERVAL{1};  // how often old finished jobs are deleted
+constexpr std::int64_t REQUEST_ID_WINDOW_MS = 24LL * 3600 * 1000;  // a repeat within 24 h returns the first job
 
+/// Empty when `request_id` is a usable idempotency key, else the problem.
+std::string request_id_problem(const std::string& request_id) {
+  if (request_id.size() > MAX_REQUEST_ID_LENGTH)
+    return "request_id is " + std::to_string(request_id.size()) + " characters long, over the limit of " +
+           std::to_string(MAX_REQUEST_ID_LENGTH);
+  for (const char c : request_id)
+    if (c < 0x21 || c > 0x7e) return "request_id must be printable ASCII without spaces";
+  return "";
+}               // tries to record a failure before leaving it to the next start
 v1::JobState to_proto(JobState state) {
   switch (state) {
     case JobState::Queued: return v1::JOB_STATE_QUEUED;
@@ -42,26 +50,11 @@ v1::JobState to_proto(JobState state) {
 }
 
 v1::JobKind kind_to_proto(const std::string& kind) {
-  if (kind == KIND_SIMULATE) return v1::JOB_KIND_SIMULATE;
-  if (kind == KIND_DESIGN) return v1::JOB_KIND_DESIGN;
-  if (kind == KIND_FIT_MATERIAL) return v1::JOB_KIND_FIT_MATERIAL;
-  return v1::JOB_KIND_UNSPECIFIED;
+  const JobKind* found = job_kind_named(kind);
+  return found ? found->proto_kind() : v1::JOB_KIND_UNSPECIFIED;
 }
 
 std::int64_t now_ms() { return store::now_ms(); }
-
-std::string format_number(double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), "%g", value);
-  return buffer;
-}
-
-/// A decoded, checked simulate job, or an error with the status code it deserves.
-struct LoadedSimulate {
-  std::optional<jobs::SimulateInput> input;
-  StatusCode code = StatusCode::Ok;
-  std::string error;
-};
 
 void fill_progress(const store::ProgressRecord& record, v1::Progress* progress) {
   progress->set_phase(record.phase);
@@ -84,186 +77,11 @@ v1::JobEvent state_event(const std::string& job_id, v1::JobState state, const st
 
 }  // namespace
 
-/// Mesh format enum -> the extension core's mesh_io takes; empty for UNSPECIFIED or unknown values.
-static std::string mesh_format_extension(v1::MeshFormat format) {
-  switch (format) {
-    case v1::MESH_FORMAT_OBJ: return "obj";
-    case v1::MESH_FORMAT_STL: return "stl";
-    case v1::MESH_FORMAT_PLY: return "ply";
-    case v1::MESH_FORMAT_OFF: return "off";
-    case v1::MESH_FORMAT_GLTF: return "gltf";
-    case v1::MESH_FORMAT_GLB: return "glb";
-    default: return "";
-  }
-}
-
-static LoadedSimulate load_simulate(const v1::SimulateJob& job, const std::string& tenant, int max_vertices,
-                                    MaterialHandler& materials) {
-  LoadedSimulate loaded;
-  auto failure = [&](StatusCode code, std::string message) {
-    loaded.code = code;
-    loaded.error = std::move(message);
-    return loaded;
-  };
-  if (job.rest_mesh().data().empty()) return failure(StatusCode::InvalidArgument, "rest_mesh is empty");
-  const std::string extension = mesh_format_extension(job.rest_mesh().format());
-  if (extension.empty())
-    return failure(StatusCode::InvalidArgument, "rest_mesh.format is missing or unknown (OBJ, STL, PLY, OFF, GLTF, GLB)");
-  Result<TriMesh> mesh = read_mesh_from_memory(job.rest_mesh().data(), extension, upload_limits(max_vertices));
-  if (!mesh) {
-    return failure(is_over_limit_error(mesh.error()) ? StatusCode::ResourceExhausted : StatusCode::InvalidArgument,
-                   "rest_mesh: " + mesh.error());
-  }
-  if (max_vertices > 0 && mesh->vertex_count() > max_vertices)
-    return failure(StatusCode::ResourceExhausted, "rest_mesh has " + std::to_string(mesh->vertex_count()) +
-                                                      " vertices, over this server's limit of " +
-                                                      std::to_string(max_vertices));
-  Result<Material> material = materials.resolve(tenant, job.material());
-  if (!material) return failure(StatusCode::InvalidArgument, "material: " + material.error());
-
-  jobs::SimulateParameters parameters;
-  parameters.thickness_mm = job.thickness_mm() == 0.0 ? jobs::DEFAULT_THICKNESS_MM : job.thickness_mm();
-  if (job.control_case() == v1::SimulateJob::kPressureKpa) parameters.pressure_kpa = job.pressure_kpa();
-  if (job.control_case() == v1::SimulateJob::kVolumeRatio) parameters.volume_ratio = job.volume_ratio();
-  Result<jobs::SimulateInput> input = jobs::prepare_simulate(std::move(*mesh), *material, parameters);
-  if (!input) {
-    // prepare_simulate prefixes mesh problems with "mesh: "; name the field the caller knows.
-    std::string message = input.error();
-    if (message.rfind("mesh: ", 0) == 0) message = "rest_" + message;
-    return failure(StatusCode::InvalidArgument, message);
-  }
-  loaded.input = std::move(*input);
-  return loaded;
-}
-
-/// A decoded, checked design job, or an error with the status code it deserves.
-struct LoadedDesign {
-  std::optional<jobs::DesignInput> input;
-  StatusCode code = StatusCode::Ok;
-  std::string error;
-};
-
-static LoadedDesign load_design(const v1::DesignJob& job, const std::string& tenant, int max_vertices,
-                                MaterialHandler& materials) {
-  LoadedDesign loaded;
-  auto failure = [&](StatusCode code, std::string message) {
-    loaded.code = code;
-    loaded.error = std::move(message);
-    return loaded;
-  };
-  if (job.target_mesh().data().empty()) return failure(StatusCode::InvalidArgument, "target_mesh is empty");
-  const std::string extension = mesh_format_extension(job.target_mesh().format());
-  if (extension.empty())
-    return failure(StatusCode::InvalidArgument, "target_mesh.format is missing or unknown (OBJ, STL, PLY, OFF, GLTF, GLB)");
-  Result<TriMesh> mesh = read_mesh_from_memory(job.target_mesh().data(), extension, upload_limits(max_vertices));
-  if (!mesh) {
-    return failure(is_over_limit_error(mesh.error()) ? StatusCode::ResourceExhausted : StatusCode::InvalidArgument,
-                   "target_mesh: " + mesh.error());
-  }
-  if (max_vertices > 0 && mesh->vertex_count() > max_vertices)
-    return failure(StatusCode::ResourceExhausted, "target_mesh has " + std::to_string(mesh->vertex_count()) +
-                                                      " vertices, over this server's limit of " +
-                                                      std::to_string(max_vertices));
-  Result<Material> material = materials.resolve(tenant, job.material());
-  if (!material) return failure(StatusCode::InvalidArgument, "material: " + material.error());
-
-  jobs::DesignParameters parameters;
-  parameters.thickness_mm = job.thickness_mm() == 0.0 ? jobs::DEFAULT_THICKNESS_MM : job.thickness_mm();
-  parameters.size_mm = job.size_mm();
-  // On the wire 0 means the default and < 0 "never remesh" (proto3 has no unset ints); here 0 never remeshes.
-  parameters.resolution = job.resolution() == 0 ? jobs::DEFAULT_DESIGN_RESOLUTION : std::max(0, job.resolution());
-  if (job.inflation_case() == v1::DesignJob::kScale) parameters.scale = job.scale();
-  if (job.inflation_case() == v1::DesignJob::kVolumeRatio) parameters.volume_ratio = job.volume_ratio();
-  parameters.method = job.method();
-  parameters.nozzle = job.nozzle();
-  parameters.max_time_s = job.max_time_s();
-  parameters.tolerance_samples = job.tolerance_samples();
-  if (max_vertices > 0 && parameters.resolution > max_vertices)
-    return failure(StatusCode::ResourceExhausted, "resolution " + std::to_string(parameters.resolution) +
-                                                      " is over this server's limit of " +
-                                                      std::to_string(max_vertices) + " vertices");
-  Result<jobs::DesignInput> input = jobs::prepare_design(std::move(*mesh), *material, parameters);
-  if (!input) {
-    std::string message = input.error();
-    if (message.rfind("mesh: ", 0) == 0) message = "target_" + message;
-    return failure(StatusCode::InvalidArgument, message);
-  }
-  loaded.input = std::move(*input);
-  return loaded;
-}
-
-/// The name a measurement set goes by: its label, or "data[i]" when the client sent none.
-static std::string measurement_label(const v1::FitMaterialJob& job, int i) {
-  return job.data(i).label().empty() ? "data[" + std::to_string(i) + "]" : job.data(i).label();
-}
-
-/// The proto measurement sets as the job layer's files.
-static std::vector<jobs::FitDataFile> fit_files(const v1::FitMaterialJob& job) {
-  std::vector<jobs::FitDataFile> files;
-  files.reserve(static_cast<size_t>(job.data_size()));
-  for (int i = 0; i < job.data_size(); ++i) {
-    const v1::MeasurementSet& set = job.data(i);
-    jobs::FitDataFile file;
-    file.label = measurement_label(job, i);
-    file.csv_text = set.csv();
-    file.test = set.test();
-    file.radius_mm = set.radius_mm();
-    file.thickness_mm = set.thickness_mm();
-    files.push_back(std::move(file));
-  }
-  return files;
-}
-
-/// Checks a fit job (data, model, the name it stores under). Errors carry their status code.
-static ServiceStatus check_fit(const v1::FitMaterialJob& job, std::optional<jobs::FitInput>* input) {
-  if (job.data_size() == 0) return ServiceStatus::error(StatusCode::InvalidArgument, "fit_material.data is empty");
-  if (!job.name().empty()) {
-    const std::string problem = material_name_problem(job.name());
-    if (!problem.empty()) return ServiceStatus::error(StatusCode::InvalidArgument, "fit_material.name: " + problem);
-    const std::vector<std::string> presets = preset_names();
-    if (std::find(presets.begin(), presets.end(), job.name()) != presets.end())
-      return ServiceStatus::error(StatusCode::PermissionDenied,
-                                  "fit_material.name: '" + job.name() + "' is a preset and cannot be overwritten");
-  }
-  Result<jobs::FitInput> prepared = jobs::prepare_fit(fit_files(job), job.model());
-  if (!prepared) return ServiceStatus::error(StatusCode::InvalidArgument, "fit_material: " + prepared.error());
-  *input = std::move(*prepared);
-  return ServiceStatus::success();
-}
-
-static std::string fit_summary(const v1::FitMaterialJob& job, const jobs::FitInput& input) {
-  std::string summary = "fit_material " + job.model() + " to " + std::to_string(input.sets.size()) + " data set(s)";
-  if (!job.name().empty()) summary += ", stored as " + job.name();
-  return summary;
-}
-
-static std::string design_summary(const jobs::DesignInput& input) {
-  std::string summary = "design " + std::to_string(input.target.mesh.vertex_count()) + " vertices, " +
-                        (input.material.name.empty() ? material_spec(input.material) : input.material.name) + ", " +
-                        format_number(input.parameters.thickness_mm) + " mm, " + design_method_name(input.method) + ", ";
-  if (input.parameters.scale)
-    summary += "scale " + format_number(*input.parameters.scale);
-  else
-    summary += "V/V0=" + format_number(input.parameters.volume_ratio ? *input.parameters.volume_ratio
-                                                                     : DesignOptions{}.volume_ratio);
-  return summary;
-}
-
-static std::string simulate_summary(const jobs::SimulateInput& input) {
-  std::string summary = "simulate " + std::to_string(input.rest.vertex_count()) + " vertices, " +
-                        (input.material.name.empty() ? material_spec(input.material) : input.material.name) + ", " +
-                        format_number(input.thickness_mm) + " mm, ";
-  if (input.control == InflationControl::Pressure)
-    summary += "p=" + format_number(input.pressure_kpa) + " kPa";
-  else
-    summary += "V/V0=" + format_number(input.volume_ratio);
-  return summary;
-}
-
-
 JobHandler::JobHandler(const ServiceOptions& options, store::Store& store, MaterialHandler& materials)
     : m_options(options), m_store(store), m_jobs(store), m_materials(materials),
-      m_queue(static_cast<std::size_t>(std::max(1, options.max_queue))) {
+      m_queue(static_cast<std::size_t>(std::max(1, options.max_queue)), options.max_queued_per_tenant,
+              options.max_running_per_tenant),
+      m_pool(m_queue, [this](std::int64_t row_id) { run_job(row_id); }, options.log) {
   std::random_device device;
   m_id_state = (static_cast<std::uint64_t>(device()) << 32) ^ device() ^
                static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count());
@@ -298,8 +116,10 @@ int JobHandler::start() {
   if (!m_options.run_jobs) return 0;  // a client-only process: leave every job as the store has it
   const bool sole_user = acquire_store_lock();
   if (m_options.recover && sole_user) {
-    for (const store::JobRecord& job : m_jobs.recover_unfinished()) {
-      m_queue.push_recovered(job.row_id, job.priority);
+    const store::JobStore::Recovery recovery = m_jobs.recover_unfinished(m_options.max_attempts);
+    for (const store::JobRecord& job : recovery.crashed) log("job " + job.job_id + " failed: " + job.error);
+    for (const store::JobRecord& job : recovery.queued) {
+      m_queue.push_recovered(job.row_id, job.owner, job.priority);
       ++recovered;
     }
     if (recovered > 0) log("recovered " + std::to_string(recovered) + " unfinished job(s) from " + m_store.path());
@@ -307,8 +127,11 @@ int JobHandler::start() {
     log("another process uses " + m_store.path() + "; not recovering its unfinished jobs");
   }
   if (m_lock_fd >= 0 && sole_user) ::flock(m_lock_fd, LOCK_SH);  // let other processes share the store now
-  for (int i = 0; i < m_options.workers; ++i) m_workers.emplace_back([this] { worker_loop(); });
-  m_watchdog = std::thread([this] { watchdog_loop(); });
+  m_pool.start(m_options.workers);
+  if (m_options.retention_days > 0.0 && sole_user) {
+    apply_retention();
+    m_retention = std::thread([this] { retention_loop(); });
+  }
   return recovered;
 }
 
@@ -326,15 +149,11 @@ std::string JobHandler::new_job_id() {
 
 ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobRequest& request,
                                  v1::SubmitJobResponse* reply) {
-  if (m_stopping) return ServiceStatus::error(StatusCode::Unavailable, "the server is shutting down");
+  if (m_pool.stopping()) return ServiceStatus::error(StatusCode::Unavailable, "the server is shutting down");
   const v1::JobSpec& spec = request.spec();
-  switch (spec.kind_case()) {
-    case v1::JobSpec::kSimulate: break;
-    case v1::JobSpec::kDesign: break;
-    case v1::JobSpec::kFitMaterial: break;
-    case v1::JobSpec::KIND_NOT_SET:
-      return ServiceStatus::error(StatusCode::InvalidArgument, "spec names no job (simulate, design or fit_material)");
-  }
+  const JobKind* kind = job_kind_for(spec);
+  if (kind == nullptr)
+    return ServiceStatus::error(StatusCode::InvalidArgument, "spec names no job (simulate, design or fit_material)");
   if (spec.priority() < -100 || spec.priority() > 100)
     return ServiceStatus::error(StatusCode::InvalidArgument, "priority must be within -100..100");
   if (spec.priority() > 0 && !caller.may_raise_priority)
@@ -343,58 +162,86 @@ ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobReques
   if (!std::isfinite(spec.time_limit_s()) || spec.time_limit_s() < 0.0)
     return ServiceStatus::error(StatusCode::InvalidArgument, "time_limit_s must be a finite number >= 0 (s)");
 
-  // Store the material as resolved now: a stored material edited later must not change a queued job.
-  v1::JobSpec stored = spec;
-  const std::vector<std::string> presets = preset_names();
-  const auto is_stored_name = [&](const v1::MaterialRef& ref) {
-    return ref.kind_case() == v1::MaterialRef::kName &&
-           std::find(presets.begin(), presets.end(), ref.name()) == presets.end();
+  const std::string& request_id = request.request_id();
+  if (const std::string problem = request_id_problem(request_id); !problem.empty())
+    return ServiceStatus::error(StatusCode::InvalidArgument, problem);
+  // A retry of a submission that reached the store returns the first job: nothing is parsed or stored.
+  const auto first_submission = [&]() -> std::optional<store::JobRecord> {
+    if (request_id.empty()) return std::nullopt;
+    return m_jobs.find_request(caller.tenant, request_id, now_ms() - REQUEST_ID_WINDOW_MS);
   };
-  std::string kind, summary;
-  if (spec.kind_case() == v1::JobSpec::kDesign) {
-    LoadedDesign loaded = load_design(spec.design(), caller.tenant, m_options.max_mesh_vertices, m_materials);
-    if (!loaded.input) return ServiceStatus::error(loaded.code, loaded.error);
-    if (is_stored_name(spec.design().material()))
-      stored.mutable_design()->mutable_material()->set_spec(material_spec(loaded.input->material));
-    kind = KIND_DESIGN;
-    summary = design_summary(*loaded.input);
-  } else if (spec.kind_case() == v1::JobSpec::kFitMaterial) {
-    std::optional<jobs::FitInput> input;
-    const ServiceStatus checked = check_fit(spec.fit_material(), &input);
-    if (!checked.ok()) return checked;
-    kind = KIND_FIT_MATERIAL;
-    summary = fit_summary(spec.fit_material(), *input);
-  } else {
-    LoadedSimulate loaded = load_simulate(spec.simulate(), caller.tenant, m_options.max_mesh_vertices, m_materials);
-    if (!loaded.input) return ServiceStatus::error(loaded.code, loaded.error);
-    if (is_stored_name(spec.simulate().material()))
-      stored.mutable_simulate()->mutable_material()->set_spec(material_spec(loaded.input->material));
-    kind = KIND_SIMULATE;
-    summary = simulate_summary(*loaded.input);
+  if (const auto first = first_submission()) {
+    fill_job(*first, reply->mutable_job());
+    return ServiceStatus::success();
   }
 
-  if (!m_queue.reserve())
-    return ServiceStatus::error(StatusCode::ResourceExhausted,
-                                "the queue is full (" + std::to_string(m_queue.capacity()) + " jobs waiting); retry later");
+  // The queue and quota checks come before any parsing: a refused job costs the server nothing.
+  switch (m_queue.reserve(caller.tenant)) {
+    case JobQueue::Reservation::Reserved: break;
+    case JobQueue::Reservation::QueueFull:
+      return ServiceStatus::error(StatusCode::ResourceExhausted, "the queue is full (" +
+                                                                     std::to_string(m_queue.capacity()) +
+                                                                     " jobs waiting); retry later");
+    case JobQueue::Reservation::TenantFull:
+      return ServiceStatus::error(StatusCode::ResourceExhausted,
+                                  "quota max-queued-per-tenant: " + std::to_string(m_options.max_queued_per_tenant) +
+                                      " jobs of yours are queued, the limit; retry when some have started");
+  }
+  if (m_options.max_stored_mb_per_tenant > 0) {
+    const std::int64_t limit = static_cast<std::int64_t>(m_options.max_stored_mb_per_tenant) << 20;
+    const std::int64_t stored = m_jobs.stored_bytes(caller.tenant);
+    if (stored + static_cast<std::int64_t>(request.ByteSizeLong()) > limit) {
+      m_queue.release_reservation(caller.tenant);
+      char used[32];
+      std::snprintf(used, sizeof(used), "%.1f", static_cast<double>(stored) / (1 << 20));
+      return ServiceStatus::error(StatusCode::ResourceExhausted,
+                                  "quota max-stored-mb-per-tenant: your jobs store " + std::string(used) +
+                                      " MiB, the limit is " + std::to_string(m_options.max_stored_mb_per_tenant) +
+                                      " MiB with this job; delete finished jobs (DeleteJob) first");
+    }
+  }
+  CheckedJob checked;
+  ServiceStatus status;
+  try {
+    status = kind->check(spec, CheckContext{caller, m_materials, m_options.max_mesh_vertices}, &checked);
+  } catch (...) {
+    m_queue.release_reservation(caller.tenant);
+    throw;
+  }
+  if (!status.ok()) {
+    m_queue.release_reservation(caller.tenant);
+    return status;
+  }
   store::JobRecord record;
   record.job_id = new_job_id();
   record.owner = caller.tenant;
-  record.kind = kind;
+  record.kind = kind->name();
   record.state = JobState::Queued;
   record.priority = spec.priority();
-  record.summary = summary;
+  record.summary = checked.summary;
   record.created_ms = now_ms();
-  if (!stored.SerializeToString(&record.spec)) {
-    m_queue.release_reservation();
+  if (!checked.stored_spec.SerializeToString(&record.spec)) {
+    m_queue.release_reservation(caller.tenant);
     return ServiceStatus::error(StatusCode::Internal, "could not serialize the job spec");
   }
-  try {
-    m_jobs.insert(record);
-  } catch (...) {
-    m_queue.release_reservation();
-    throw;
+  record.request_id = request_id;
+  {
+    // Two copies of one request in flight at once: the second finds the first here.
+    std::unique_lock request_lock(m_request_mutex, std::defer_lock);
+    if (!request_id.empty()) request_lock.lock();
+    try {
+      if (const auto first = first_submission()) {
+        m_queue.release_reservation(caller.tenant);
+        fill_job(*first, reply->mutable_job());
+        return ServiceStatus::success();
+      }
+      m_jobs.insert(record);
+    } catch (...) {
+      m_queue.release_reservation(caller.tenant);
+      throw;
+    }
   }
-  m_queue.push_reserved(record.row_id, record.priority);
+  m_queue.push_reserved(record.row_id, record.owner, record.priority);
   log("job " + record.job_id + " submitted by " + caller.tenant + ": " + record.summary);
   fill_job(record, reply->mutable_job());
   return ServiceStatus::success();
@@ -461,20 +308,16 @@ ServiceStatus JobHandler::cancel(const Caller& caller, const v1::CancelJobReques
   auto record = find_owned(caller, request.job_id());
   if (!record) return ServiceStatus::error(StatusCode::NotFound, "no job '" + request.job_id() + "'");
   if (!store::is_terminal(record->state)) {
-    m_queue.remove(record->row_id);
+    // The store first: if its write fails the job is still queued (in memory and on disk) and the caller
+    // gets an error; a worker that pops it meanwhile finds it cancelled and skips it.
     const std::string reason = "cancelled by its owner";
-    if (m_jobs.mark_cancelled(record->row_id, reason)) {
+    const bool cancelled = m_jobs.mark_cancelled(record->row_id, reason);
+    m_queue.remove(record->row_id);
+    if (cancelled) {
       // A running job stops at its next iteration; its state is final already.
-      {
-        std::lock_guard lock(m_active_mutex);
-        if (const auto it = m_active.find(record->row_id); it != m_active.end()) {
-          int expected = static_cast<int>(StopReason::None);
-          it->second->stop_reason.compare_exchange_strong(expected, static_cast<int>(StopReason::Cancelled));
-          it->second->token.cancel();
-        }
-      }
+      m_pool.stop(record->row_id, StopReason::Cancelled);
       log("job " + record->job_id + " cancelled");
-      close_watchers(record->job_id, state_event(record->job_id, v1::JOB_STATE_CANCELLED, reason));
+      m_watches.finish(record->job_id, state_event(record->job_id, v1::JOB_STATE_CANCELLED, reason));
     }
     record = m_jobs.find(request.job_id());
   }
@@ -482,64 +325,64 @@ ServiceStatus JobHandler::cancel(const Caller& caller, const v1::CancelJobReques
   return ServiceStatus::success();
 }
 
-ServiceStatus JobHandler::watch(const Caller& caller, const v1::WatchJobRequest& request,
-                                std::shared_ptr<WatchChannel>* channel) {
-  if (m_stopping) return ServiceStatus::error(StatusCode::Unavailable, "the server is shutting down");
-  if (!find_owned(caller, request.job_id()))
-    return ServiceStatus::error(StatusCode::NotFound, "no job '" + request.job_id() + "'");
-  auto opened = std::make_shared<WatchChannel>();
-  // Subscribe and take the snapshot under the watcher lock: publishers wait, so the snapshot comes first.
-  std::lock_guard lock(m_watch_mutex);
-  const auto record = m_jobs.find(request.job_id());
+ServiceStatus JobHandler::remove(const Caller& caller, const v1::DeleteJobRequest& request, v1::DeleteJobResponse*) {
+  const auto record = find_owned(caller, request.job_id());
   if (!record) return ServiceStatus::error(StatusCode::NotFound, "no job '" + request.job_id() + "'");
-  v1::JobEvent snapshot = state_event(record->job_id, to_proto(record->state), "");
-  if (record->last_progress) fill_progress(*record->last_progress, snapshot.mutable_progress());
-  snapshot.set_converged(record->converged);
-  if (store::is_terminal(record->state)) {
-    snapshot.set_message(record->error.empty() ? std::string("finished") : record->error);
-    opened->close(std::move(snapshot), ServiceStatus::success());
-  } else {
-    snapshot.set_message(record->state == JobState::Queued ? "queued" : "running");
-    opened->push(std::move(snapshot), nullptr);
-    m_watchers.emplace(record->job_id, opened);
-  }
-  *channel = std::move(opened);
+  if (!store::is_terminal(record->state) || !m_jobs.delete_finished(record->row_id))
+    return ServiceStatus::error(StatusCode::FailedPrecondition,
+                                "job " + record->job_id + " is " + store::to_string(record->state) +
+                                    "; cancel it before deleting it");
+  log("job " + record->job_id + " deleted by its owner");
   return ServiceStatus::success();
 }
 
-void JobHandler::unwatch(const std::shared_ptr<WatchChannel>& channel) {
-  std::lock_guard lock(m_watch_mutex);
-  for (auto it = m_watchers.begin(); it != m_watchers.end();) {
-    if (it->second == channel)
-      it = m_watchers.erase(it);
-    else
-      ++it;
+void JobHandler::apply_retention() {
+  const std::int64_t cutoff = now_ms() - static_cast<std::int64_t>(m_options.retention_days * 86400e3);
+  try {
+    const int deleted = m_jobs.delete_finished_before(cutoff);
+    if (deleted > 0)
+      log("retention: deleted " + std::to_string(deleted) + " job(s) finished more than " +
+          format_number(m_options.retention_days) + " days ago");
+  } catch (const std::exception& error) {
+    log(std::string("retention: could not delete old jobs: ") + error.what());
   }
 }
 
-void JobHandler::publish(const std::string& job_id, v1::JobEvent event) {
-  std::vector<std::shared_ptr<WatchChannel>> channels;
-  std::shared_ptr<const std::vector<std::uint32_t>> triangles;
-  {
-    std::lock_guard lock(m_watch_mutex);
-    const auto range = m_watchers.equal_range(job_id);
-    for (auto it = range.first; it != range.second; ++it) channels.push_back(it->second);
-    if (const auto it = m_connectivity.find(job_id); it != m_connectivity.end()) triangles = it->second;
+void JobHandler::retention_loop() {
+  std::unique_lock lock(m_retention_mutex);
+  while (!m_retention_wake.wait_for(lock, RETENTION_INTERVAL, [this] { return m_retention_stop; })) {
+    lock.unlock();
+    apply_retention();
+    lock.lock();
   }
-  for (const auto& channel : channels) channel->push(event, triangles);
 }
 
-void JobHandler::close_watchers(const std::string& job_id, v1::JobEvent last_event) {
-  std::vector<std::shared_ptr<WatchChannel>> channels;
-  {
-    std::lock_guard lock(m_watch_mutex);
-    const auto range = m_watchers.equal_range(job_id);
-    for (auto it = range.first; it != range.second; ++it) channels.push_back(it->second);
-    m_watchers.erase(range.first, range.second);
-    m_connectivity.erase(job_id);
-  }
-  for (const auto& channel : channels) channel->close(last_event, ServiceStatus::success());
+ServiceStatus JobHandler::watch(const Caller& caller, const v1::WatchJobRequest& request,
+                                std::shared_ptr<WatchChannel>* channel) {
+  if (m_pool.stopping()) return ServiceStatus::error(StatusCode::Unavailable, "the server is shutting down");
+  if (!find_owned(caller, request.job_id()))
+    return ServiceStatus::error(StatusCode::NotFound, "no job '" + request.job_id() + "'");
+  // The snapshot is taken under the hub's lock: publishers wait, so the snapshot comes first.
+  const auto first_events = [&](WatchChannel& opened, bool* subscribe) {
+    const auto record = m_jobs.find(request.job_id());
+    if (!record) return ServiceStatus::error(StatusCode::NotFound, "no job '" + request.job_id() + "'");
+    v1::JobEvent snapshot = state_event(record->job_id, to_proto(record->state), "");
+    if (record->last_progress) fill_progress(*record->last_progress, snapshot.mutable_progress());
+    snapshot.set_converged(record->converged);
+    if (store::is_terminal(record->state)) {
+      snapshot.set_message(record->error.empty() ? std::string("finished") : record->error);
+      opened.close(std::move(snapshot), ServiceStatus::success());
+    } else {
+      snapshot.set_message(record->state == JobState::Queued ? "queued" : "running");
+      opened.push(std::move(snapshot), nullptr);
+      *subscribe = true;
+    }
+    return ServiceStatus::success();
+  };
+  return m_watches.open(request.job_id(), caller.tenant, m_options.max_watches_per_tenant, first_events, channel);
 }
+
+void JobHandler::unwatch(const std::shared_ptr<WatchChannel>& channel) { m_watches.close(channel); }
 
 ServiceStatus JobHandler::result(const Caller& caller, const v1::GetResultRequest& request, v1::JobResult* reply) {
   const auto record = find_owned(caller, request.job_id());
@@ -553,56 +396,13 @@ ServiceStatus JobHandler::result(const Caller& caller, const v1::GetResultReques
   const std::string extension = mesh_format_extension(format);
   if (extension.empty() || !is_writable_mesh_format(extension))
     return ServiceStatus::error(StatusCode::InvalidArgument, "meshes can be returned as OBJ, STL or PLY only");
+  const JobKind* kind = job_kind_named(record->kind);
+  if (kind == nullptr)
+    return ServiceStatus::error(StatusCode::Internal, "job " + record->job_id + " has an unknown kind");
   const auto stored = m_jobs.result(record->row_id);
   if (!stored) return ServiceStatus::error(StatusCode::Internal, "job " + record->job_id + " has lost its result");
-  if (record->kind == KIND_FIT_MATERIAL) {
-    // A fit has no meshes: the report is the whole result.
-    reply->set_job_id(record->job_id);
-    reply->set_kind(kind_to_proto(record->kind));
-    reply->set_converged(stored->converged);
-    reply->set_report_json(stored->report_json);
-    return ServiceStatus::success();
-  }
-  const Result<TriMesh> rest = store::decode_mesh_blob(stored->rest_mesh);
-  const Result<TriMesh> inflated = store::decode_mesh_blob(stored->inflated_mesh);
-  if (!rest || !inflated) return ServiceStatus::error(StatusCode::Internal, "stored meshes are unreadable");
   reply->set_job_id(record->job_id);
-  reply->set_kind(kind_to_proto(record->kind));
-  reply->set_converged(stored->converged);
-  reply->mutable_rest_mesh()->set_format(format);
-  reply->mutable_rest_mesh()->set_data(write_mesh_to_memory(*rest, extension));
-  reply->mutable_inflated_mesh()->set_format(format);
-  reply->mutable_inflated_mesh()->set_data(write_mesh_to_memory(*inflated, extension));
-  reply->set_report_json(stored->report_json);
-  return ServiceStatus::success();
-}
-
-void JobHandler::worker_loop() {
-  while (const std::optional<std::int64_t> row = m_queue.pop()) {
-    try {
-      run_job(*row);
-    } catch (const std::exception& error) {
-      // A job must never take its worker down with it.
-      log(std::string("worker: unexpected error: ") + error.what());
-    }
-  }
-}
-
-void JobHandler::watchdog_loop() {
-  std::unique_lock lock(m_watchdog_mutex);
-  while (!m_stopping) {
-    m_watchdog_wake.wait_for(lock, std::chrono::milliseconds(50));
-    const auto now = std::chrono::steady_clock::now();
-    std::lock_guard active_lock(m_active_mutex);
-    for (auto& [row, active] : m_active) {
-      const double elapsed = std::chrono::duration<double>(now - active->started).count();
-      if (active->time_limit_s > 0.0 && elapsed > active->time_limit_s) {
-        int expected = static_cast<int>(StopReason::None);
-        if (active->stop_reason.compare_exchange_strong(expected, static_cast<int>(StopReason::TimeLimit)))
-          active->token.cancel();
-      }
-    }
-  }
+  return kind->fill_result(*stored, format, reply);
 }
 
 void JobHandler::run_job(std::int64_t row_id) {
@@ -612,88 +412,65 @@ void JobHandler::run_job(std::int64_t row_id) {
   record->state = JobState::Running;
   record->attempts += 1;
 
-  auto active = std::make_shared<ActiveJob>();
-  active->job_id = record->job_id;
-  active->started = std::chrono::steady_clock::now();
   v1::JobSpec spec;
   const bool spec_ok = spec.ParseFromString(record->spec);
-  active->time_limit_s = spec.time_limit_s() > 0.0 ? std::min(spec.time_limit_s(), m_options.job_time_limit_s)
-                                                   : m_options.job_time_limit_s;
-  {
-    std::lock_guard lock(m_active_mutex);
-    m_active[row_id] = active;
-    // A shutdown that began before we registered would miss this job: stop it ourselves.
-    if (m_stopping) {
-      active->stop_reason = static_cast<int>(StopReason::Shutdown);
-      active->token.cancel();
-    }
-  }
+  const double time_limit_s = spec.time_limit_s() > 0.0 ? std::min(spec.time_limit_s(), m_options.job_time_limit_s)
+                                                        : m_options.job_time_limit_s;
+  const std::shared_ptr<ActiveJob> active = m_pool.enter(row_id, record->job_id, record->owner, time_limit_s);
   log("job " + record->job_id + " started (attempt " + std::to_string(record->attempts) + ")");
-  publish(record->job_id, state_event(record->job_id, v1::JOB_STATE_RUNNING,
-                                      "started (attempt " + std::to_string(record->attempts) + ")"));
+  m_watches.publish(record->job_id, state_event(record->job_id, v1::JOB_STATE_RUNNING,
+                                                "started (attempt " + std::to_string(record->attempts) + ")"));
   try {
-    if (spec_ok && spec.kind_case() == v1::JobSpec::kSimulate) {
-      run_simulate_job(*record, spec, *active);
-    } else if (spec_ok && spec.kind_case() == v1::JobSpec::kDesign) {
-      run_design_job(*record, spec, *active);
-    } else if (spec_ok && spec.kind_case() == v1::JobSpec::kFitMaterial) {
-      run_fit_job(*record, spec, *active);
+    const JobKind* kind = spec_ok ? job_kind_for(spec) : nullptr;
+    if (kind == nullptr) {
+      fail_job(*record, spec_ok ? "this server cannot run this kind of job" : "the stored job spec is unreadable");
     } else {
-      const std::string error = spec_ok ? "this server cannot run this kind of job" : "the stored job spec is unreadable";
-      m_jobs.mark_failed(row_id, error);
-      close_watchers(record->job_id, state_event(record->job_id, v1::JOB_STATE_FAILED, error));
+      RunContext context{*record, spec, active->token, progress_publisher(*record, spec),
+                         [this, &record](const Faces& faces) { m_watches.set_connectivity(record->job_id, faces); },
+                         m_materials};
+      finish_run(*record, *kind, *active, kind->run(context));
     }
   } catch (const std::exception& error) {
-    const std::string message = std::string("internal error: ") + error.what();
-    m_jobs.mark_failed(row_id, message);
-    log("job " + record->job_id + " failed: " + message);
-    close_watchers(record->job_id, state_event(record->job_id, v1::JOB_STATE_FAILED, message));
+    fail_job(*record, std::string("internal error: ") + error.what());
   }
-  std::lock_guard lock(m_active_mutex);
-  m_active.erase(row_id);
+  m_pool.leave(row_id);
 }
 
-void JobHandler::run_simulate_job(const store::JobRecord& record, const v1::JobSpec& spec, ActiveJob& active) {
-  // The limit on vertices was applied at submit time; a job accepted then runs now even if the limit shrank.
-  LoadedSimulate loaded = load_simulate(spec.simulate(), record.owner, 0, m_materials);
-  if (!loaded.input) {
-    m_jobs.mark_failed(record.row_id, loaded.error);
-    log("job " + record.job_id + " failed: " + loaded.error);
-    close_watchers(record.job_id, state_event(record.job_id, v1::JOB_STATE_FAILED, loaded.error));
-    return;
-  }
-  const jobs::SimulateInput& input = *loaded.input;
-  set_connectivity(record.job_id, input.rest.faces);
-  jobs::RunControls controls;
-  controls.cancel = &active.token;
-  controls.progress = progress_publisher(record, spec);
-
-  const jobs::SimulateOutcome outcome = jobs::run_simulate(input, controls);
-  if (active.stop_reason != static_cast<int>(StopReason::None)) {
+void JobHandler::finish_run(const store::JobRecord& record, const JobKind&, const ActiveJob& active,
+                            RunOutcome outcome) {
+  if (active.reason() != StopReason::None || outcome.kind == RunOutcome::Kind::Stopped) {
     finish_stopped(record, active);
     return;
   }
-  store::ResultRecord result;
-  result.converged = outcome.result.converged;
-  result.rest_mesh = store::encode_mesh_blob(input.rest);
-  result.inflated_mesh = store::encode_mesh_blob(TriMesh{outcome.result.deformed, input.rest.faces});
-  result.report_json = outcome.report_json;
-  if (!m_jobs.mark_completed(record.row_id, result)) return;  // cancelled as it finished: that already published
-  const std::string message = outcome.result.converged
-                                  ? "completed: converged in " + format_number(outcome.result.time_s) + " s"
-                                  : "completed without converging: " + outcome.result.message;
-  log("job " + record.job_id + " " + message);
-  v1::JobEvent done = state_event(record.job_id, v1::JOB_STATE_COMPLETED, message);
+  if (outcome.kind == RunOutcome::Kind::Failed) {
+    fail_job(record, outcome.message);
+    return;
+  }
+  if (!m_jobs.mark_completed(record.row_id, outcome.result)) return;  // cancelled as it finished: that already published
+  log("job " + record.job_id + " " + outcome.message);
+  v1::JobEvent done = state_event(record.job_id, v1::JOB_STATE_COMPLETED, outcome.message);
   done.set_converged(outcome.result.converged);
-  close_watchers(record.job_id, std::move(done));
+  m_watches.finish(record.job_id, std::move(done));
 }
 
-void JobHandler::set_connectivity(const std::string& job_id, const Faces& faces) {
-  auto triangles = std::make_shared<std::vector<std::uint32_t>>();
-  triangles->reserve(static_cast<std::size_t>(faces.size()));
-  for (Eigen::Index i = 0; i < faces.size(); ++i) triangles->push_back(static_cast<std::uint32_t>(faces.data()[i]));
-  std::lock_guard lock(m_watch_mutex);
-  m_connectivity[job_id] = std::move(triangles);
+void JobHandler::fail_job(const store::JobRecord& record, const std::string& error) {
+  // A store failure here must not leave the row in 'running' while the server lives on: retry a few
+  // times; if the store still refuses, the next start applies the attempts rule to the row.
+  for (int attempt = 1;; ++attempt) {
+    try {
+      m_jobs.mark_failed(record.row_id, error);
+      break;
+    } catch (const std::exception& store_error) {
+      if (attempt == FAIL_WRITE_ATTEMPTS) {
+        log("job " + record.job_id + ": could not record its failure (" + store_error.what() +
+            "); the next start re-queues it or fails it by --max-attempts");
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(100 * attempt));
+    }
+  }
+  log("job " + record.job_id + " failed: " + error);
+  m_watches.finish(record.job_id, state_event(record.job_id, v1::JOB_STATE_FAILED, error));
 }
 
 ProgressCallback JobHandler::progress_publisher(const store::JobRecord& record, const v1::JobSpec& spec) {
@@ -740,109 +517,23 @@ ProgressCallback JobHandler::progress_publisher(const store::JobRecord& record, 
       m_jobs.append_progress(row_id, checkpoint, shape);
       state->last_checkpoint = now;
     }
-    publish(job_id, std::move(event));
+    m_watches.publish(job_id, event);
   };
 }
 
-void JobHandler::run_design_job(const store::JobRecord& record, const v1::JobSpec& spec, ActiveJob& active) {
-  // The limit on vertices was applied at submit time; a job accepted then runs now even if the limit shrank.
-  LoadedDesign loaded = load_design(spec.design(), record.owner, 0, m_materials);
-  if (!loaded.input) {
-    m_jobs.mark_failed(record.row_id, loaded.error);
-    log("job " + record.job_id + " failed: " + loaded.error);
-    close_watchers(record.job_id, state_event(record.job_id, v1::JOB_STATE_FAILED, loaded.error));
-    return;
-  }
-  const jobs::DesignInput& input = *loaded.input;
-  set_connectivity(record.job_id, input.target.mesh.faces);
-  jobs::RunControls controls;
-  controls.cancel = &active.token;
-  controls.progress = progress_publisher(record, spec);
-
-  const jobs::DesignOutcome outcome = jobs::run_design(input, controls);
-  if (active.stop_reason != static_cast<int>(StopReason::None)) {
-    finish_stopped(record, active);
-    return;
-  }
-  if (outcome.result.rest.vertex_count() == 0) {
-    const std::string error = "the design produced no rest shape: " + outcome.result.message;
-    m_jobs.mark_failed(record.row_id, error);
-    log("job " + record.job_id + " failed: " + error);
-    close_watchers(record.job_id, state_event(record.job_id, v1::JOB_STATE_FAILED, error));
-    return;
-  }
-  store::ResultRecord result;
-  result.converged = outcome.result.converged;
-  result.rest_mesh = store::encode_mesh_blob(outcome.result.rest);
-  result.inflated_mesh = store::encode_mesh_blob(TriMesh{outcome.result.inflated, outcome.result.rest.faces});
-  result.report_json = outcome.report_json;
-  if (!m_jobs.mark_completed(record.row_id, result)) return;  // cancelled as it finished: that already published
-  const std::string errors = jobs::design_error_summary(outcome.result);
-  const std::string message = (outcome.result.converged ? "completed: converged in " : "completed without converging in ") +
-                              format_number(outcome.result.time_s) + " s, " + errors +
-                              (outcome.result.converged ? std::string() : ": " + outcome.result.message);
-  log("job " + record.job_id + " " + message);
-  v1::JobEvent done = state_event(record.job_id, v1::JOB_STATE_COMPLETED, message);
-  done.set_converged(outcome.result.converged);
-  close_watchers(record.job_id, std::move(done));
-}
-
-void JobHandler::run_fit_job(const store::JobRecord& record, const v1::JobSpec& spec, ActiveJob& active) {
-  const auto fail_job = [&](const std::string& error) {
-    m_jobs.mark_failed(record.row_id, error);
-    log("job " + record.job_id + " failed: " + error);
-    close_watchers(record.job_id, state_event(record.job_id, v1::JOB_STATE_FAILED, error));
-  };
-  const v1::FitMaterialJob& job = spec.fit_material();
-  std::optional<jobs::FitInput> input;
-  if (const ServiceStatus checked = check_fit(job, &input); !checked.ok()) return fail_job(checked.message);
-  // The fit has no iteration callback: it cannot be stopped midway, only its outcome discarded.
-  Result<jobs::FitOutcome> outcome = jobs::run_fit(*input);
-  if (active.stop_reason != static_cast<int>(StopReason::None)) {
-    finish_stopped(record, active);
-    return;
-  }
-  if (!outcome) return fail_job(outcome.error());
-  const FitResult& best = outcome->fits[static_cast<size_t>(jobs::best_fit_index(*outcome))];
-  std::string stored_note;
-  if (!job.name().empty()) {
-    std::vector<std::string> labels;
-    for (int i = 0; i < job.data_size(); ++i) labels.push_back(measurement_label(job, i));
-    v1::PutMaterialRequest put;
-    put.mutable_material()->set_name(job.name());
-    put.mutable_material()->set_spec(material_spec(best.material));
-    put.mutable_material()->set_description(jobs::fit_provenance(*input, best, labels));
-    v1::Material stored_material;
-    const ServiceStatus status = m_materials.put(Caller{record.owner}, put, &stored_material);
-    if (!status.ok()) return fail_job("storing material '" + job.name() + "': " + status.message);
-    stored_note = ", stored as " + stored_material.name();
-  }
-  store::ResultRecord result;
-  result.converged = true;
-  for (const FitResult& fit : outcome->fits) result.converged = result.converged && fit.converged;
-  result.report_json = jobs::fit_report_json(*input, *outcome);
-  if (!m_jobs.mark_completed(record.row_id, result)) return;  // cancelled as it finished: that already published
-  const std::string message = "completed: best fit " + material_spec(best.material) + " in " +
-                              format_number(outcome->time_s) + " s" + stored_note;
-  log("job " + record.job_id + " " + message);
-  v1::JobEvent done = state_event(record.job_id, v1::JOB_STATE_COMPLETED, message);
-  done.set_converged(result.converged);
-  close_watchers(record.job_id, std::move(done));
-}
-
-void JobHandler::finish_stopped(const store::JobRecord& record, ActiveJob& active) {
-  switch (static_cast<StopReason>(active.stop_reason.load())) {
+void JobHandler::finish_stopped(const store::JobRecord& record, const ActiveJob& active) {
+  switch (active.reason()) {
     case StopReason::Shutdown:
-      m_jobs.mark_requeued(record.row_id);
+      try {
+        m_jobs.mark_requeued(record.row_id);
+      } catch (const std::exception& error) {
+        log("job " + record.job_id + ": could not re-queue it (" + error.what() + "); the next start does");
+      }
       log("job " + record.job_id + " interrupted by shutdown; it runs again at the next start");
       break;
-    case StopReason::TimeLimit: {
-      const std::string error = "time limit of " + format_number(active.time_limit_s) + " s exceeded";
-      m_jobs.mark_failed(record.row_id, error);
-      log("job " + record.job_id + " failed: " + error);
-      close_watchers(record.job_id, state_event(record.job_id, v1::JOB_STATE_FAILED, error));
+    case StopReason::TimeLimit:
+      fail_job(record, "time limit of " + format_number(active.time_limit_s) + " s exceeded");
       break;
-    }
     case StopReason::Cancelled:
       log("job " + record.job_id + " stopped after cancellation");
       break;
@@ -851,37 +542,20 @@ void JobHandler::finish_stopped(const store::JobRecord& record, ActiveJob& activ
 }
 
 void JobHandler::shutdown() {
-  if (m_stopping.exchange(true)) return;
-  m_queue.close();
   {
-    std::lock_guard lock(m_active_mutex);
-    for (auto& [row, active] : m_active) {
-      int expected = static_cast<int>(StopReason::None);
-      active->stop_reason.compare_exchange_strong(expected, static_cast<int>(StopReason::Shutdown));
-      active->token.cancel();
-    }
+    std::lock_guard lock(m_retention_mutex);
+    m_retention_stop = true;
   }
-  m_watchdog_wake.notify_all();
-  for (std::thread& worker : m_workers)
-    if (worker.joinable()) worker.join();
-  if (m_watchdog.joinable()) m_watchdog.join();
-  std::vector<std::shared_ptr<WatchChannel>> channels;
-  {
-    std::lock_guard lock(m_watch_mutex);
-    for (auto& [job_id, channel] : m_watchers) channels.push_back(channel);
-    m_watchers.clear();
-  }
-  for (const auto& channel : channels)
-    channel->close(std::nullopt, ServiceStatus::error(StatusCode::Unavailable, "the server is shutting down"));
+  m_retention_wake.notify_all();
+  if (m_retention.joinable()) m_retention.join();
+  m_pool.shutdown();
+  m_watches.close_all(ServiceStatus::error(StatusCode::Unavailable, "the server is shutting down"));
   if (m_lock_fd >= 0) {
     ::close(m_lock_fd);  // releases the flock
     m_lock_fd = -1;
   }
 }
 
-int JobHandler::running_count() const {
-  std::lock_guard lock(m_active_mutex);
-  return static_cast<int>(m_active.size());
-}
+int JobHandler::running_count() const { return m_pool.running_count(); }
 
 }  // namespace balloon::service

@@ -1,7 +1,8 @@
 #pragma once
-/// The job side of the service: submit (check, store, queue), get, list, cancel, watch and results,
-/// with the worker threads that run queued jobs. Takes and returns API messages; knows nothing of gRPC
-/// (the adapter in server/rpc converts statuses and streams).
+/// The job verbs of the service: submit (check, store, queue), get, list, cancel, watch and results, and
+/// what a worker does with a queued job (run its kind, record the outcome). What each kind does lives in
+/// its JobKind, the threads in WorkerPool, the watchers in WatchHub. Takes and returns API messages;
+/// knows nothing of gRPC (the adapter in server/rpc converts statuses and streams).
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
@@ -14,11 +15,14 @@
 #include "balloon/v1/balloon.pb.h"
 #include "progress.hpp"
 #include "service/caller.hpp"
+#include "service/job_kind.hpp"
 #include "service/job_queue.hpp"
 #include "service/material_handler.hpp"
 #include "service/service_options.hpp"
 #include "service/service_status.hpp"
 #include "service/watch_channel.hpp"
+#include "service/watch_hub.hpp"
+#include "service/worker_pool.hpp"
 #include "store/job_store.hpp"
 
 namespace balloon::service {
@@ -31,11 +35,14 @@ class JobHandler {
   JobHandler(const JobHandler&) = delete;
   JobHandler& operator=(const JobHandler&) = delete;
 
-  /// Re-queues unfinished jobs from the store (when this process is the store's only user) and starts
-  /// the workers. Returns the number of jobs recovered.
+  /// Re-queues unfinished jobs from the store (when this process is the store's only user; a job that
+  /// already started max_attempts times FAILS instead), applies the retention and starts the workers.
+  /// Returns the number of jobs recovered.
   int start();
 
-  /// Checks the job (mesh, material, options) and returns once it is stored and queued.
+  /// Checks the queue and the caller's quotas, then the job (mesh, material, options; cheap checks only:
+  /// no remeshing), and returns once it is stored and queued. A request_id the caller used within 24 h
+  /// returns that first job instead.
   ServiceStatus submit(const Caller& caller, const balloon::v1::SubmitJobRequest& request,
                        balloon::v1::SubmitJobResponse* reply);
   ServiceStatus get(const Caller& caller, const balloon::v1::GetJobRequest& request, balloon::v1::Job* reply);
@@ -43,6 +50,10 @@ class JobHandler {
                      balloon::v1::ListJobsResponse* reply);
   /// Queued: removed at once. Running: stopped within one solver iteration; the state is CANCELLED at once.
   ServiceStatus cancel(const Caller& caller, const balloon::v1::CancelJobRequest& request, balloon::v1::Job* reply);
+  /// Deletes a finished job of the caller with its result. FAILED_PRECONDITION for a queued or running
+  /// job (cancel it first), NOT_FOUND for a missing job or another tenant's.
+  ServiceStatus remove(const Caller& caller, const balloon::v1::DeleteJobRequest& request,
+                       balloon::v1::DeleteJobResponse* reply);
   /// Opens a channel that receives the job's current state, then its events until it finishes.
   ServiceStatus watch(const Caller& caller, const balloon::v1::WatchJobRequest& request,
                       std::shared_ptr<WatchChannel>* channel);
@@ -59,38 +70,21 @@ class JobHandler {
   int running_count() const;
 
  private:
-  enum class StopReason : int { None = 0, Cancelled = 1, TimeLimit = 2, Shutdown = 3 };
-
-  /// A job on a worker.
-  struct ActiveJob {
-    std::string job_id;
-    balloon::CancelToken token;
-    std::atomic<int> stop_reason{0};
-    double time_limit_s = 0.0;
-    std::chrono::steady_clock::time_point started;
-  };
-
-  void worker_loop();
-  void watchdog_loop();
   void run_job(std::int64_t row_id);
-  /// Runs a simulate job to its end state (completed, failed, cancelled or re-queued) and publishes it.
-  void run_simulate_job(const store::JobRecord& record, const balloon::v1::JobSpec& spec, ActiveJob& active);
-  /// Runs a design job (jobs/design_job) to its end state and publishes it, like run_simulate_job.
-  void run_design_job(const store::JobRecord& record, const balloon::v1::JobSpec& spec, ActiveJob& active);
-  /// Runs a material-fit job (jobs/fit_job): the report JSON is its result; with a name, the best fit is
-  /// stored as the owner's material (with its provenance) before the job completes.
-  void run_fit_job(const store::JobRecord& record, const balloon::v1::JobSpec& spec, ActiveJob& active);
-  /// The triangles the first intermediate mesh of a job's watchers carries.
-  void set_connectivity(const std::string& job_id, const Faces& faces);
+  /// Records an outcome of a run: completed (result stored), failed, or stopped (finish_stopped).
+  void finish_run(const store::JobRecord& record, const JobKind& kind, const ActiveJob& active, RunOutcome outcome);
+  /// The one failure path: marks the job failed in the store, logs, and closes its watchers.
+  void fail_job(const store::JobRecord& record, const std::string& error);
   /// A progress callback that publishes a running job's events (with the intermediate mesh every K
   /// events) and checkpoints them in the store at most every checkpoint_interval_s.
   ProgressCallback progress_publisher(const store::JobRecord& record, const balloon::v1::JobSpec& spec);
   /// Records a job that stopped early: cancelled (already stored), timed out, or re-queued at shutdown.
-  void finish_stopped(const store::JobRecord& record, ActiveJob& active);
+  void finish_stopped(const store::JobRecord& record, const ActiveJob& active);
   bool acquire_store_lock();
+  /// Deletes finished jobs older than retention_days (at start, then hourly on its own thread).
+  void apply_retention();
+  void retention_loop();
 
-  void publish(const std::string& job_id, balloon::v1::JobEvent event);
-  void close_watchers(const std::string& job_id, balloon::v1::JobEvent last_event);
   void fill_job(const store::JobRecord& record, balloon::v1::Job* job) const;
   std::optional<store::JobRecord> find_owned(const Caller& caller, const std::string& job_id);
   std::string new_job_id();
@@ -101,22 +95,18 @@ class JobHandler {
   store::JobStore m_jobs;
   MaterialHandler& m_materials;
   JobQueue m_queue;
+  WatchHub m_watches;
+  WorkerPool m_pool;
 
-  mutable std::mutex m_active_mutex;
-  std::map<std::int64_t, std::shared_ptr<ActiveJob>> m_active;
+  std::thread m_retention;
+  std::mutex m_retention_mutex;
+  std::condition_variable m_retention_wake;
+  bool m_retention_stop = false;
 
-  std::mutex m_watch_mutex;
-  std::multimap<std::string, std::shared_ptr<WatchChannel>> m_watchers;
-  std::map<std::string, std::shared_ptr<const std::vector<std::uint32_t>>> m_connectivity;
-
-  std::vector<std::thread> m_workers;
-  std::thread m_watchdog;
-  std::mutex m_watchdog_mutex;
-  std::condition_variable m_watchdog_wake;
-  std::atomic<bool> m_stopping{false};
   bool m_started = false;
   int m_lock_fd = -1;
 
+  std::mutex m_request_mutex;  // held from the request_id lookup to the insert
   std::mutex m_id_mutex;
   std::uint64_t m_id_state = 0;
 };

@@ -15,6 +15,12 @@ struct ServiceOptions {
   int progress_mesh_every = 1;          ///< default K: every K-th shape-carrying progress event streams the mesh
   double checkpoint_interval_s = 0.25;  ///< at most one stored progress checkpoint per job per interval (s)
   bool recover = true;                  ///< re-queue unfinished jobs at start (only if no other process uses the store)
+  int max_attempts = 3;                 ///< a job found running at start after this many starts FAILS; 0 no limit
+  int max_queued_per_tenant = 100;      ///< queued jobs per tenant; more get RESOURCE_EXHAUSTED; 0 no limit
+  int max_running_per_tenant = 4;       ///< jobs of one tenant running at once (others wait their turn); 0 no limit
+  int max_watches_per_tenant = 64;      ///< open watch streams per tenant; more get RESOURCE_EXHAUSTED; 0 no limit
+  int max_stored_mb_per_tenant = 2048;  ///< MiB of specs and results a tenant may store; 0 no limit
+  double retention_days = 90.0;         ///< finished jobs older than this are deleted (days); 0 keeps them forever
   bool run_jobs = true;                 ///< false: accept and store jobs but start no workers (a short-lived CLI)
   std::string shard_name;               ///< --shard-name: prefixes every new job id ("s2-j-..."); empty: none
   /// Receives one log line per job event; empty for silence (the embedded CLI server).

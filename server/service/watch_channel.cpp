@@ -16,19 +16,63 @@ void WatchChannel::push(balloon::v1::JobEvent event,
       }
     }
     m_events.push_back(std::move(event));
-    // A slow watcher: drop the oldest events that carry only progress (never state changes, never the
-    // one carrying the connectivity), so memory stays bounded and the latest state still arrives.
-    for (auto it = m_events.begin(); m_events.size() > MAX_PENDING && it != m_events.end();) {
-      const bool droppable = it->message().empty() && it->mesh().triangles_size() == 0 && std::next(it) != m_events.end();
-      if (droppable) {
-        it = m_events.erase(it);
-        ++m_dropped;
-      } else {
-        ++it;
-      }
-    }
+    trim_locked();
   }
   notify();
+}
+
+namespace {
+
+std::size_t mesh_bytes(const balloon::v1::JobEvent& event) {
+  if (!event.has_mesh()) return 0;
+  return 4u * static_cast<std::size_t>(event.mesh().positions_mm_size() + event.mesh().triangles_size());
+}
+
+/// A state change (or the first snapshot) is never dropped; only a running job's progress reports are.
+bool is_progress_only(const balloon::v1::JobEvent& event) {
+  return event.state() == balloon::v1::JOB_STATE_RUNNING && event.message().empty();
+}
+
+}  // namespace
+
+void WatchChannel::strip_mesh_locked(std::deque<balloon::v1::JobEvent>::iterator it) {
+  if (it->mesh().triangles_size() > 0) {
+    auto next = std::next(it);
+    while (next != m_events.end() && !next->has_mesh()) ++next;
+    if (next != m_events.end())
+      next->mutable_mesh()->mutable_triangles()->Swap(it->mutable_mesh()->mutable_triangles());
+    else
+      m_sent_connectivity = false;  // the next mesh pushed carries them again
+  }
+  it->clear_mesh();
+  ++m_dropped_meshes;
+}
+
+void WatchChannel::trim_locked() {
+  // Meshes first: strip the oldest until the rest fit the budget; the newest always stays.
+  std::size_t total = 0;
+  auto newest_mesh = m_events.end();
+  for (auto it = m_events.begin(); it != m_events.end(); ++it) {
+    total += mesh_bytes(*it);
+    if (it->has_mesh()) newest_mesh = it;
+  }
+  for (auto it = m_events.begin(); total > MAX_PENDING_MESH_BYTES && it != newest_mesh; ++it) {
+    if (!it->has_mesh()) continue;
+    const std::size_t triangle_bytes = 4u * static_cast<std::size_t>(it->mesh().triangles_size());
+    total -= mesh_bytes(*it);
+    strip_mesh_locked(it);
+    if (m_sent_connectivity) total += triangle_bytes;  // they moved on to a later queued mesh
+  }
+  // Then the count: drop the oldest progress-only events (never state changes, never the newest event).
+  for (auto it = m_events.begin(); m_events.size() > MAX_PENDING && it != m_events.end();) {
+    if (is_progress_only(*it) && std::next(it) != m_events.end()) {
+      if (it->has_mesh()) strip_mesh_locked(it);
+      it = m_events.erase(it);
+      ++m_dropped;
+    } else {
+      ++it;
+    }
+  }
 }
 
 void WatchChannel::close(std::optional<balloon::v1::JobEvent> last_event, ServiceStatus status) {
@@ -63,6 +107,11 @@ ServiceStatus WatchChannel::final_status() const {
 std::uint64_t WatchChannel::dropped() const {
   std::lock_guard lock(m_mutex);
   return m_dropped;
+}
+
+std::uint64_t WatchChannel::dropped_meshes() const {
+  std::lock_guard lock(m_mutex);
+  return m_dropped_meshes;
 }
 
 void WatchChannel::set_notifier(std::function<void()> notifier) {

@@ -1,7 +1,9 @@
 #pragma once
 /// One watcher's queue of job events, between the worker that publishes them and the stream that sends
 /// them. Knows nothing of gRPC: the stream registers a notifier and pulls events one at a time, so one
-/// slow watcher never blocks a worker (its old progress events are dropped instead).
+/// slow watcher never blocks a worker. Bounded: a watcher that does not read loses intermediate meshes
+/// first (the oldest, keeping their progress numbers), then old progress-only events, never a state
+/// change; the newest mesh always stays, and the triangles move on to the next mesh it receives.
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -19,6 +21,9 @@ class WatchChannel {
  public:
   /// Events waiting beyond this count make the channel drop its oldest progress-only events.
   static constexpr std::size_t MAX_PENDING = 64;
+  /// Bytes of intermediate meshes (positions and triangles) waiting beyond this make the channel strip
+  /// the mesh from its oldest mesh events (about 2 meshes of 200k vertices).
+  static constexpr std::size_t MAX_PENDING_MESH_BYTES = 8u << 20;
 
   /// Queues an event. A mesh event gets the job's connectivity if this watcher has not had it yet.
   /// Ignored once the channel is closed.
@@ -38,9 +43,15 @@ class WatchChannel {
 
   /// Events dropped because the watcher was slow.
   std::uint64_t dropped() const;
+  /// Intermediate meshes dropped (stripped from their events or dropped with them) because the watcher was slow.
+  std::uint64_t dropped_meshes() const;
 
  private:
   void notify();
+  /// Applies the bounds above (m_mutex held).
+  void trim_locked();
+  /// Removes the mesh of *it; triangles it carried move to the next queued mesh, or to the next pushed one.
+  void strip_mesh_locked(std::deque<balloon::v1::JobEvent>::iterator it);
 
   mutable std::mutex m_mutex;
   std::deque<balloon::v1::JobEvent> m_events;
@@ -48,6 +59,7 @@ class WatchChannel {
   bool m_sent_connectivity = false;
   ServiceStatus m_status;
   std::uint64_t m_dropped = 0;
+  std::uint64_t m_dropped_meshes = 0;
 
   std::recursive_mutex m_notifier_mutex;  // recursive: a notifier may re-enter through a synchronous callback
   std::function<void()> m_notifier;

@@ -4,21 +4,24 @@ namespace balloon::store {
 namespace {
 
 constexpr const char* INSERT_JOB =
-    "INSERT INTO jobs (job_id, owner, kind, state, priority, spec, summary, created_ms) "
-    "VALUES (?, ?, ?, ?, ?, ?, ?, ?)";
+    "INSERT INTO jobs (job_id, owner, kind, state, priority, spec, summary, created_ms, request_id) "
+    "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)";
 
 // The latest progress row of each job joins in through its maximum id (index progress_job).
 #define JOB_COLUMNS                                                                                     \
   "jobs.id, jobs.job_id, jobs.owner, jobs.kind, jobs.state, jobs.priority, jobs.spec, jobs.summary, "  \
   "jobs.error, jobs.converged, jobs.created_ms, jobs.started_ms, jobs.finished_ms, jobs.attempts, "     \
   "p.phase, p.iteration, p.elapsed_s, p.residual_norm, p.pressure_kpa, p.avg_error_mm, p.max_error_mm, " \
-  "p.recorded_ms "
+  "p.recorded_ms, jobs.request_id "
 #define JOB_FROM                                                                                        \
   "FROM jobs LEFT JOIN progress AS p ON p.id = "                                                        \
   "(SELECT MAX(id) FROM progress WHERE progress.job_row = jobs.id) "
 
 constexpr const char* SELECT_JOB_BY_ID = "SELECT " JOB_COLUMNS JOB_FROM "WHERE jobs.job_id = ?";
 constexpr const char* SELECT_JOB_BY_ROW = "SELECT " JOB_COLUMNS JOB_FROM "WHERE jobs.id = ?";
+constexpr const char* SELECT_JOB_BY_REQUEST =
+    "SELECT " JOB_COLUMNS JOB_FROM
+    "WHERE jobs.owner = ? AND jobs.request_id = ? AND jobs.created_ms >= ? ORDER BY jobs.id DESC LIMIT 1";
 constexpr const char* SELECT_JOBS_PAGE =
     "SELECT " JOB_COLUMNS JOB_FROM
     "WHERE jobs.owner = ? AND jobs.id < ? AND (? = '' OR jobs.state = ?) ORDER BY jobs.id DESC LIMIT ?";
@@ -33,6 +36,8 @@ constexpr const char* MARK_CANCELLED =
     "WHERE id = ? AND state IN ('queued', 'running')";
 constexpr const char* MARK_REQUEUED = "UPDATE jobs SET state = 'queued' WHERE id = ? AND state = 'running'";
 constexpr const char* REQUEUE_ALL_RUNNING = "UPDATE jobs SET state = 'queued' WHERE state = 'running'";
+constexpr const char* SELECT_CRASHED_JOBS =
+    "SELECT " JOB_COLUMNS JOB_FROM "WHERE jobs.state = 'running' AND jobs.attempts >= ? ORDER BY jobs.id ASC";
 constexpr const char* MARK_COMPLETED =
     "UPDATE jobs SET state = 'completed', converged = ?, finished_ms = ?, error = '' "
     "WHERE id = ? AND state = 'running'";
@@ -52,6 +57,17 @@ constexpr const char* INSERT_PROGRESS =
     "max_error_mm, recorded_ms, shape) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)";
 constexpr const char* SELECT_LATEST_SHAPE =
     "SELECT shape FROM progress WHERE job_row = ? AND shape IS NOT NULL ORDER BY id DESC LIMIT 1";
+constexpr const char* DELETE_FINISHED_JOB =
+    "DELETE FROM jobs WHERE id = ? AND state IN ('completed', 'failed', 'cancelled')";
+constexpr const char* DELETE_FINISHED_BEFORE =
+    "DELETE FROM jobs WHERE state IN ('completed', 'failed', 'cancelled') AND finished_ms < ?";
+// length() of a BLOB reads its size, not its bytes.
+constexpr const char* SELECT_STORED_BYTES =
+    "SELECT (SELECT COALESCE(SUM(LENGTH(spec) + LENGTH(summary) + LENGTH(error)), 0) FROM jobs WHERE owner = ?) + "
+    "(SELECT COALESCE(SUM(LENGTH(r.rest_mesh) + LENGTH(r.inflated_mesh) + LENGTH(CAST(r.report_json AS BLOB))), 0) "
+    " FROM results AS r JOIN jobs AS j ON j.id = r.job_row WHERE j.owner = ?) + "
+    "(SELECT COALESCE(SUM(COALESCE(LENGTH(p.shape), 0) + 64), 0) "
+    " FROM progress AS p JOIN jobs AS j ON j.id = p.job_row WHERE j.owner = ?)";
 constexpr const char* COUNT_PROGRESS = "SELECT COUNT(*) FROM progress WHERE job_row = ?";
 
 #undef JOB_COLUMNS
@@ -85,6 +101,7 @@ JobRecord read_job(const Statement& row) {
     progress.recorded_ms = row.column_int64(21);
     job.last_progress = progress;
   }
+  job.request_id = row.column_text(22);
   return job;
 }
 
@@ -118,7 +135,8 @@ void JobStore::insert(JobRecord& job) {
       .bind(5, job.priority)
       .bind_blob(6, job.spec)
       .bind(7, job.summary)
-      .bind(8, job.created_ms);
+      .bind(8, job.created_ms)
+      .bind(9, job.request_id);
   statement.run();
   job.row_id = m_store.database().last_insert_id();
 }
@@ -135,6 +153,15 @@ std::optional<JobRecord> JobStore::find_row(std::int64_t row_id) {
   std::lock_guard lock(m_store.mutex());
   Statement statement = m_store.database().prepare(SELECT_JOB_BY_ROW);
   statement.bind(1, row_id);
+  if (!statement.step()) return std::nullopt;
+  return read_job(statement);
+}
+
+std::optional<JobRecord> JobStore::find_request(const std::string& owner, const std::string& request_id,
+                                                std::int64_t since_ms) {
+  std::lock_guard lock(m_store.mutex());
+  Statement statement = m_store.database().prepare(SELECT_JOB_BY_REQUEST);
+  statement.bind(1, owner).bind(2, request_id).bind(3, since_ms);
   if (!statement.step()) return std::nullopt;
   return read_job(statement);
 }
@@ -238,6 +265,25 @@ int JobStore::progress_count(std::int64_t row_id) {
   return statement.step() ? statement.column_int(0) : 0;
 }
 
+bool JobStore::delete_finished(std::int64_t row_id) {
+  std::lock_guard lock(m_store.mutex());
+  m_store.database().prepare(DELETE_FINISHED_JOB).bind(1, row_id).run();
+  return m_store.database().changes() == 1;
+}
+
+int JobStore::delete_finished_before(std::int64_t cutoff_ms) {
+  std::lock_guard lock(m_store.mutex());
+  m_store.database().prepare(DELETE_FINISHED_BEFORE).bind(1, cutoff_ms).run();
+  return m_store.database().changes();
+}
+
+std::int64_t JobStore::stored_bytes(const std::string& owner) {
+  std::lock_guard lock(m_store.mutex());
+  Statement statement = m_store.database().prepare(SELECT_STORED_BYTES);
+  statement.bind(1, owner).bind(2, owner).bind(3, owner);
+  return statement.step() ? statement.column_int64(0) : 0;
+}
+
 std::optional<ResultRecord> JobStore::result(std::int64_t row_id) {
   std::lock_guard lock(m_store.mutex());
   Statement statement = m_store.database().prepare(SELECT_RESULT);
@@ -252,17 +298,32 @@ std::optional<ResultRecord> JobStore::result(std::int64_t row_id) {
   return result;
 }
 
-std::vector<JobRecord> JobStore::recover_unfinished() {
+JobStore::Recovery JobStore::recover_unfinished(int max_attempts) {
   std::lock_guard lock(m_store.mutex());
   Transaction transaction(m_store.database());
+  Recovery recovery;
+  if (max_attempts > 0) {
+    {
+      Statement statement = m_store.database().prepare(SELECT_CRASHED_JOBS);
+      statement.bind(1, max_attempts);
+      while (statement.step()) recovery.crashed.push_back(read_job(statement));
+    }
+    const std::int64_t now = now_ms();
+    for (JobRecord& job : recovery.crashed) {
+      job.state = JobState::Failed;
+      job.error = "crashed the server " + std::to_string(job.attempts) + " times (--max-attempts " +
+                  std::to_string(max_attempts) + "); it is not run again";
+      job.finished_ms = now;
+      m_store.database().prepare(MARK_FAILED).bind(1, job.error).bind(2, now).bind(3, job.row_id).run();
+    }
+  }
   m_store.database().execute(REQUEUE_ALL_RUNNING);
-  std::vector<JobRecord> jobs;
   {
     Statement statement = m_store.database().prepare(SELECT_QUEUED_JOBS);
-    while (statement.step()) jobs.push_back(read_job(statement));
+    while (statement.step()) recovery.queued.push_back(read_job(statement));
   }
   transaction.commit();
-  return jobs;
+  return recovery;
 }
 
 }  // namespace balloon::store

@@ -50,6 +50,7 @@ struct JobRecord {
   std::int64_t started_ms = 0;
   std::int64_t finished_ms = 0;
   int attempts = 0;
+  std::string request_id;      ///< the client's idempotency key; empty: none
   std::optional<ProgressRecord> last_progress;  ///< filled by find() and list()
 };
 
@@ -78,6 +79,8 @@ class JobStore {
   std::optional<JobRecord> find(const std::string& job_id);
   /// The job with this row id.
   std::optional<JobRecord> find_row(std::int64_t row_id);
+  /// The owner's newest job submitted with `request_id` at or after `since_ms` (ms since the epoch).
+  std::optional<JobRecord> find_request(const std::string& owner, const std::string& request_id, std::int64_t since_ms);
   /// The owner's jobs with row id < before_row (0: from the newest), optionally in one state.
   JobPage list(const std::string& owner, std::optional<JobState> state, std::int64_t before_row, int limit);
 
@@ -101,12 +104,28 @@ class JobStore {
   /// Number of progress checkpoints of a job.
   int progress_count(std::int64_t row_id);
 
+  /// Deletes a finished job with its result and progress (ON DELETE CASCADE). False, deleting nothing, if
+  /// the job is queued or running (or gone).
+  bool delete_finished(std::int64_t row_id);
+  /// Deletes every finished job that finished before `cutoff_ms` (ms since the epoch), with its result
+  /// and progress. Returns how many.
+  int delete_finished_before(std::int64_t cutoff_ms);
+
+  /// Bytes the owner's jobs take in the store: specs, results and progress checkpoints (shapes included).
+  std::int64_t stored_bytes(const std::string& owner);
+
   /// The stored result of a completed job.
   std::optional<ResultRecord> result(std::int64_t row_id);
 
-  /// After a crash: every Running job becomes Queued again. Returns all Queued jobs, by priority
-  /// (highest first) then age (oldest first), without their specs' progress.
-  std::vector<JobRecord> recover_unfinished();
+  /// What recover_unfinished did.
+  struct Recovery {
+    std::vector<JobRecord> queued;   ///< every Queued job afterwards, by priority (highest first) then age
+    std::vector<JobRecord> crashed;  ///< Running jobs that had used up their attempts, now Failed
+  };
+  /// After a crash: a Running job (it was running when the process died) becomes Queued again, unless it
+  /// has started `max_attempts` times already: then it becomes Failed with "crashed the server N times"
+  /// (a job that kills the process must not crash it at every restart). max_attempts <= 0: no limit.
+  Recovery recover_unfinished(int max_attempts);
 
  private:
   Store& m_store;

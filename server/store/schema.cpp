@@ -65,8 +65,14 @@ CREATE TABLE materials (
 );
 )sql";
 
+// Version 2: idempotent submission (the client's request id, looked up per owner within a window).
+constexpr const char* MIGRATION_2 = R"sql(
+ALTER TABLE jobs ADD COLUMN request_id TEXT NOT NULL DEFAULT '';
+CREATE INDEX jobs_request ON jobs (owner, request_id, created_ms) WHERE request_id <> '';
+)sql";
+
 const std::vector<const char*>& migrations() {
-  static const std::vector<const char*> list = {MIGRATION_1};
+  static const std::vector<const char*> list = {MIGRATION_1, MIGRATION_2};
   return list;
 }
 

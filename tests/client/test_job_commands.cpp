@@ -46,6 +46,27 @@ TEST(JobCommands, SubmitWatchResultThroughTheEmbeddedServer) {
   EXPECT_EQ(run_balloon(scratch, {"jobs", "cancel", job_id}).exit_code, 0);
 }
 
+TEST(JobCommands, DeleteRefusesAnUnfinishedJobAndRemovesAFinishedOne) {
+  ScratchDir scratch;
+  ASSERT_EQ(run_balloon(scratch, {"mesh", "sphere", "--radius", "10", "--subdivisions", "1", "--out", scratch.file("s.obj")})
+                .exit_code,
+            0);
+  const ProcessResult submitted =
+      run_balloon(scratch, {"submit", scratch.file("s.obj"), "--material", "latex", "--volume-ratio", "2"});
+  ASSERT_EQ(submitted.exit_code, 0) << submitted.err;
+  const std::string job_id = split_lines(submitted.out).at(0);
+  // Queued (the submit process runs no workers): refused, with the way out.
+  const ProcessResult refused = run_balloon(scratch, {"jobs", "delete", job_id});
+  EXPECT_EQ(refused.exit_code, 7) << refused.err;
+  EXPECT_NE(refused.err.find("cancel it before deleting it"), std::string::npos) << refused.err;
+  ASSERT_EQ(run_balloon(scratch, {"jobs", "cancel", job_id}).exit_code, 0);
+  const ProcessResult deleted = run_balloon(scratch, {"jobs", "delete", job_id});
+  EXPECT_EQ(deleted.exit_code, 0) << deleted.err;
+  EXPECT_NE(deleted.out.find("deleted " + job_id), std::string::npos) << deleted.out;
+  EXPECT_EQ(run_balloon(scratch, {"jobs", "show", job_id}).exit_code, 4);
+  EXPECT_EQ(run_balloon(scratch, {"jobs", "delete", job_id}).exit_code, 4);
+}
+
 TEST(JobCommands, MaterialsLibrary) {
   ScratchDir scratch;
   const ProcessResult listed = run_balloon(scratch, {"materials", "list"});

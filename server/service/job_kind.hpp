@@ -1,0 +1,93 @@
+#pragma once
+/// One kind of job (simulate, design, fit_material): how its request is checked at submit, described,
+/// run on a worker and returned as a result. Adding a kind touches one implementation file and the
+/// list in job_kinds.cpp; the handler, the pool and the watch hub do not change.
+#include <functional>
+#include <string>
+
+#include "balloon/v1/balloon.pb.h"
+#include "mesh/tri_mesh.hpp"
+#include "progress.hpp"
+#include "service/caller.hpp"
+#include "service/material_handler.hpp"
+#include "service/service_status.hpp"
+#include "store/job_store.hpp"
+
+namespace balloon::service {
+
+/// What a kind may use to check a request at submit time (cheap work only: no remeshing, no solving).
+struct CheckContext {
+  const Caller& caller;
+  MaterialHandler& materials;
+  int max_mesh_vertices = 0;  ///< larger meshes are RESOURCE_EXHAUSTED; 0 = no limit (a job accepted earlier)
+};
+
+/// A request that passed the submit checks.
+struct CheckedJob {
+  balloon::v1::JobSpec stored_spec;  ///< what the store keeps (a stored material's name resolved to its SPEC)
+  std::string summary;               ///< one human line
+};
+
+/// What a running job may use.
+struct RunContext {
+  const store::JobRecord& record;
+  const balloon::v1::JobSpec& spec;
+  const CancelToken& cancel;  ///< fires on cancel, time limit and shutdown
+  ProgressCallback progress;  ///< publishes and checkpoints progress events
+  /// Gives the watch hub the triangles the first intermediate mesh carries.
+  std::function<void(const Faces&)> set_connectivity;
+  MaterialHandler& materials;
+};
+
+/// How a run ended. The handler records it: one path for each outcome.
+struct RunOutcome {
+  enum class Kind { Completed, Failed, Stopped };
+  Kind kind = Kind::Failed;
+  store::ResultRecord result;  ///< Completed only
+  std::string message;         ///< Completed: the one-line summary; Failed: the error
+
+  static RunOutcome completed(store::ResultRecord result, std::string message) {
+    return {Kind::Completed, std::move(result), std::move(message)};
+  }
+  static RunOutcome failed(std::string error) { return {Kind::Failed, {}, std::move(error)}; }
+  /// The cancel token fired: the handler records why (cancel, time limit or shutdown).
+  static RunOutcome stopped() { return {Kind::Stopped, {}, {}}; }
+};
+
+class JobKind {
+ public:
+  virtual ~JobKind() = default;
+  /// The kind as stored ("simulate", "design", "fit_material").
+  virtual const char* name() const = 0;
+  virtual balloon::v1::JobKind proto_kind() const = 0;
+  /// Decodes and checks `spec` within the limits; errors carry their status code.
+  virtual ServiceStatus check(const balloon::v1::JobSpec& spec, const CheckContext& context,
+                              CheckedJob* checked) const = 0;
+  /// Runs the job to an outcome. May throw: the handler records any exception as a failure.
+  virtual RunOutcome run(RunContext& context) const = 0;
+  /// Fills `reply` from a stored result; meshes in `format` (checked writable by the caller).
+  virtual ServiceStatus fill_result(const store::ResultRecord& stored, balloon::v1::MeshFormat format,
+                                    balloon::v1::JobResult* reply) const;
+};
+
+/// The kind a spec asks for; null when it names none.
+const JobKind* job_kind_for(const balloon::v1::JobSpec& spec);
+/// The kind with this stored name; null for an unknown name.
+const JobKind* job_kind_named(const std::string& name);
+
+/// Mesh format enum -> the extension core's mesh_io takes; empty for UNSPECIFIED or unknown values.
+std::string mesh_format_extension(balloon::v1::MeshFormat format);
+/// "%g" of a number.
+std::string format_number(double value);
+/// True when `reference` names a tenant's stored material (not a preset, not an inline SPEC): the job
+/// then stores the SPEC as resolved at submit, so editing the material later does not change it.
+bool names_stored_material(const balloon::v1::MaterialRef& reference);
+
+}  // namespace balloon::service
+
+namespace balloon::service {
+/// The kinds (one file each: simulate_kind.cpp, design_kind.cpp, fit_material_kind.cpp).
+const JobKind& simulate_kind();
+const JobKind& design_kind();
+const JobKind& fit_material_kind();
+}  // namespace balloon::service

@@ -1,0 +1,107 @@
+// The simulate job kind: inflate a rest mesh (jobs/simulate_job) and store the rest and inflated meshes.
+#include "jobs/simulate_job.hpp"
+#include "mesh/mesh_io.hpp"
+#include "service/job_kind.hpp"
+#include "store/mesh_blob.hpp"
+
+namespace balloon::service {
+namespace {
+
+namespace v1 = balloon::v1;
+
+/// Decodes and checks a simulate job (mesh within `max_vertices`, material, parameters).
+ServiceStatus load_simulate(const v1::SimulateJob& job, const std::string& tenant, int max_vertices,
+                            MaterialHandler& materials, std::optional<jobs::SimulateInput>* loaded) {
+  if (job.rest_mesh().data().empty()) return ServiceStatus::error(StatusCode::InvalidArgument, "rest_mesh is empty");
+  const std::string extension = mesh_format_extension(job.rest_mesh().format());
+  if (extension.empty())
+    return ServiceStatus::error(StatusCode::InvalidArgument,
+                                "rest_mesh.format is missing or unknown (OBJ, STL, PLY, OFF, GLTF, GLB)");
+  Result<TriMesh> mesh = read_mesh_from_memory(job.rest_mesh().data(), extension, upload_limits(max_vertices));
+  if (!mesh) {
+    return ServiceStatus::error(
+        is_over_limit_error(mesh.error()) ? StatusCode::ResourceExhausted : StatusCode::InvalidArgument,
+        "rest_mesh: " + mesh.error());
+  }
+  if (max_vertices > 0 && mesh->vertex_count() > max_vertices)
+    return ServiceStatus::error(StatusCode::ResourceExhausted,
+                                "rest_mesh has " + std::to_string(mesh->vertex_count()) +
+                                    " vertices, over this server's limit of " + std::to_string(max_vertices));
+  Result<Material> material = materials.resolve(tenant, job.material());
+  if (!material) return ServiceStatus::error(StatusCode::InvalidArgument, "material: " + material.error());
+
+  jobs::SimulateParameters parameters;
+  parameters.thickness_mm = job.thickness_mm() == 0.0 ? jobs::DEFAULT_THICKNESS_MM : job.thickness_mm();
+  if (job.control_case() == v1::SimulateJob::kPressureKpa) parameters.pressure_kpa = job.pressure_kpa();
+  if (job.control_case() == v1::SimulateJob::kVolumeRatio) parameters.volume_ratio = job.volume_ratio();
+  Result<jobs::SimulateInput> input = jobs::prepare_simulate(std::move(*mesh), *material, parameters);
+  if (!input) {
+    // prepare_simulate prefixes mesh problems with "mesh: "; name the field the caller knows.
+    std::string message = input.error();
+    if (message.rfind("mesh: ", 0) == 0) message = "rest_" + message;
+    return ServiceStatus::error(StatusCode::InvalidArgument, message);
+  }
+  *loaded = std::move(*input);
+  return ServiceStatus::success();
+}
+
+std::string simulate_summary(const jobs::SimulateInput& input) {
+  std::string summary = "simulate " + std::to_string(input.rest.vertex_count()) + " vertices, " +
+                        (input.material.name.empty() ? material_spec(input.material) : input.material.name) + ", " +
+                        format_number(input.thickness_mm) + " mm, ";
+  if (input.control == InflationControl::Pressure)
+    summary += "p=" + format_number(input.pressure_kpa) + " kPa";
+  else
+    summary += "V/V0=" + format_number(input.volume_ratio);
+  return summary;
+}
+
+class SimulateKind final : public JobKind {
+ public:
+  const char* name() const override { return "simulate"; }
+  v1::JobKind proto_kind() const override { return v1::JOB_KIND_SIMULATE; }
+
+  ServiceStatus check(const v1::JobSpec& spec, const CheckContext& context, CheckedJob* checked) const override {
+    std::optional<jobs::SimulateInput> input;
+    const ServiceStatus status =
+        load_simulate(spec.simulate(), context.caller.tenant, context.max_mesh_vertices, context.materials, &input);
+    if (!status.ok()) return status;
+    checked->stored_spec = spec;
+    if (names_stored_material(spec.simulate().material()))
+      checked->stored_spec.mutable_simulate()->mutable_material()->set_spec(material_spec(input->material));
+    checked->summary = simulate_summary(*input);
+    return ServiceStatus::success();
+  }
+
+  RunOutcome run(RunContext& context) const override {
+    // The limit on vertices was applied at submit time; a job accepted then runs now even if the limit shrank.
+    std::optional<jobs::SimulateInput> loaded;
+    const ServiceStatus status = load_simulate(context.spec.simulate(), context.record.owner, 0, context.materials, &loaded);
+    if (!status.ok()) return RunOutcome::failed(status.message);
+    const jobs::SimulateInput& input = *loaded;
+    context.set_connectivity(input.rest.faces);
+    jobs::RunControls controls;
+    controls.cancel = &context.cancel;
+    controls.progress = context.progress;
+    const jobs::SimulateOutcome outcome = jobs::run_simulate(input, controls);
+    if (context.cancel.cancelled()) return RunOutcome::stopped();
+    store::ResultRecord result;
+    result.converged = outcome.result.converged;
+    result.rest_mesh = store::encode_mesh_blob(input.rest);
+    result.inflated_mesh = store::encode_mesh_blob(TriMesh{outcome.result.deformed, input.rest.faces});
+    result.report_json = outcome.report_json;
+    std::string message = outcome.result.converged
+                              ? "completed: converged in " + format_number(outcome.result.time_s) + " s"
+                              : "completed without converging: " + outcome.result.message;
+    return RunOutcome::completed(std::move(result), std::move(message));
+  }
+};
+
+}  // namespace
+
+const JobKind& simulate_kind() {
+  static const SimulateKind kind;
+  return kind;
+}
+
+}  // namespace balloon::service
