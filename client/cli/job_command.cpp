@@ -66,7 +66,7 @@ std::function<void(const v1::JobEvent&)> job_progress(v1::JobKind kind, double m
 }
 
 int run_job_command(const JobCommand& command, const std::vector<std::string>& args, const GlobalOptions& global,
-                    bool detach) {
+                    bool detach, const std::string& hint) {
   const std::string name = detach ? std::string("submit ") + command.name : command.name;
   if (global.help) {
     std::fputs(command.help, stdout);
@@ -83,7 +83,7 @@ int run_job_command(const JobCommand& command, const std::vector<std::string>& a
 
   // Every local check comes before any connection, so the cheapest problems are reported first.
   Result<PreparedJob> prepared = command.prepare(own);
-  if (!prepared) return report_error(name, prepared.error(), EXIT_BAD_INPUT);
+  if (!prepared) return report_error(name, prepared.error() + hint, EXIT_BAD_INPUT);
   if (const std::string problem = apply_job_options(*job_options, prepared->request); !problem.empty())
     return report_error(name, problem, EXIT_BAD_INPUT);
   if (!detach) {

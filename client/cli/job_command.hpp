@@ -43,8 +43,9 @@ struct JobCommand {
 
 /// `balloon design|simulate|fit-material ARGS...` (`detach` false; --detach in ARGS detaches) and
 /// `balloon submit KIND ARGS...` (`detach` true): the same arguments, parsed by `command.prepare`.
+/// `hint` is added to the errors in the command's own arguments.
 int run_job_command(const JobCommand& command, const std::vector<std::string>& args, const GlobalOptions& global,
-                    bool detach);
+                    bool detach, const std::string& hint = "");
 
 /// The help of the options every job command takes (--detach, --cancel-on-interrupt, --priority,
 /// --time-limit) and of Ctrl-C.

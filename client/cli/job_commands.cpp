@@ -166,7 +166,8 @@ int run_submit_command(const std::vector<std::string>& args, const GlobalOptions
     return EXIT_OK;
   }
   // `balloon submit REST_MESH ...`, the form before submit took a kind: a simulate job.
-  return run_job_command(simulate_job_command(), args, global, true);
+  return run_job_command(simulate_job_command(), args, global, true,
+                         " (balloon submit without a kind queues a simulate job; a design: balloon submit design ...)");
 }
 
 int run_jobs_command(const std::vector<std::string>& args, const GlobalOptions& global) {

@@ -144,7 +144,7 @@ int handle_interrupt(ServiceConnection& connection, const std::string& command, 
     // The embedded server stops with this process: its shutdown puts the running job back in the queue
     // of the local store, and the next command that runs jobs (jobs watch) recovers and runs it.
     std::fprintf(stderr,
-                 "\n%sinterrupted; job %s stays in %s and runs again when you resume it\n"
+                 "\n%sinterrupted; job %s stays queued in %s; resuming runs it again\n"
                  "resume with: %s\n(Ctrl-C again within 1 s cancels it)\n",
                  prefix.c_str(), job_id.c_str(), connection.database().c_str(),
                  resume_command(policy.connection, job_id).c_str());
