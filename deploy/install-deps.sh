@@ -6,14 +6,16 @@ set -euo pipefail
 PACKAGES=(
   # toolchain
   cmake ninja-build pkg-config g++ git
-  # tests and benchmarks
-  libgtest-dev libgmock-dev libbenchmark-dev
+  # tests and benchmarks (openssl: the HTTPS gateway test makes a self-signed certificate)
+  libgtest-dev libgmock-dev libbenchmark-dev openssl
   # numerics: Eigen, CHOLMOD (SuiteSparse) with OpenBLAS behind it, nanoflann (kd-tree), CGAL (remeshing, AABB)
   libeigen3-dev libsuitesparse-dev libopenblas0-pthread libnanoflann-dev libcgal-dev
   # mesh files
   libassimp-dev
   # service: gRPC, protobuf, SQLite, HTTP gateway
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler libsqlite3-dev libcpp-httplib-dev
+  # HTTPS for the gateway (--http-tls-cert): Debian's cpp-httplib is built with CPPHTTPLIB_OPENSSL_SUPPORT
+  libssl-dev
   # cross-language client test
   python3-grpcio python3-protobuf
   # several shards behind a load balancer (tests/deploy): HAProxy (the test runs its own, unprivileged; the

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "cli_output.hpp"
 #include "design_progress.hpp"
@@ -91,6 +92,9 @@ int run_job_command(const JobCommand& command, const std::vector<std::string>& a
       return report_error(name, problem, EXIT_BAD_INPUT);
   }
 
+  // Caught from before the submit: a Ctrl-C while it is under way detaches once the id is known.
+  std::optional<InterruptCatcher> interrupts;
+  if (!detach) interrupts.emplace();
   ConnectionOptions connection_options = global.connection;
   connection_options.run_jobs = !detach;  // a detached job waits in the embedded store for `jobs watch`
   auto connection = ServiceConnection::open(connection_options);
@@ -121,9 +125,8 @@ int run_job_command(const JobCommand& command, const std::vector<std::string>& a
   policy.cancel = job_options->has("cancel-on-interrupt");
   policy.connection = global.connection;
   {
-    const InterruptCatcher interrupts;
-    const WatchOutcome outcome = watch_job(**connection, job_id, interrupts, progress);
-    if (outcome.interrupted) return handle_interrupt(**connection, name, job_id, policy, interrupts);
+    const WatchOutcome outcome = watch_job(**connection, job_id, *interrupts, progress);
+    if (outcome.interrupted) return handle_interrupt(**connection, name, job_id, policy, *interrupts);
     if (!outcome.status.ok()) return report_error(name, outcome.status.error_message(), exit_code_for(outcome.status));
     if (outcome.state == v1::JOB_STATE_FAILED && command.failed_exit_code != nullptr)
       return report_error(name, outcome.message, command.failed_exit_code(outcome.message));

@@ -71,12 +71,11 @@ WatchOutcome watch_job(ServiceConnection& connection, const std::string& job_id,
   balloon::v1::WatchJobRequest request;
   request.set_job_id(job_id);
 
-  const int presses_before = interrupts.count();
   std::atomic<bool> done{false};
   // A blocking Read cannot see a signal: this thread turns Ctrl-C into a cancelled call.
   std::thread monitor([&] {
     while (!done.load()) {
-      if (interrupts.count() > presses_before) {
+      if (interrupts.count() > 0) {
         context.TryCancel();
         return;
       }
@@ -94,7 +93,7 @@ WatchOutcome watch_job(ServiceConnection& connection, const std::string& job_id,
   outcome.status = reader->Finish();
   done.store(true);
   monitor.join();
-  outcome.interrupted = interrupts.count() > presses_before;
+  outcome.interrupted = interrupts.count() > 0;
   return outcome;
 }
 

@@ -34,7 +34,7 @@ struct WatchOutcome {
 };
 
 /// Streams `job_id`'s events to `on_event` until the job reaches a final state, the stream fails, or
-/// Ctrl-C is pressed (seen through `interrupts`).
+/// Ctrl-C is (or was, since `interrupts` started catching) pressed.
 WatchOutcome watch_job(ServiceConnection& connection, const std::string& job_id, const InterruptCatcher& interrupts,
                        const std::function<void(const balloon::v1::JobEvent&)>& on_event);
 

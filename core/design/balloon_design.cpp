@@ -27,6 +27,19 @@ std::string design_method_name(DesignMethod method) {
   return method == DesignMethod::Adjoint ? "adjoint" : "alm";
 }
 
+std::string design_stop_name(DesignStop stop) {
+  switch (stop) {
+    case DesignStop::Matched: return "matched";
+    case DesignStop::Optimal: return "optimal";
+    case DesignStop::Stalled: return "stalled";
+    case DesignStop::TimeLimit: return "time_limit";
+    case DesignStop::IterationLimit: return "iteration_limit";
+    case DesignStop::StartFailed: return "start_failed";
+    case DesignStop::Cancelled: return "cancelled";
+  }
+  return "stalled";
+}
+
 Result<DesignMethod> parse_design_method(const std::string& name) {
   if (name == "adjoint") return DesignMethod::Adjoint;
   if (name == "alm") return DesignMethod::AugmentedLagrangian;
@@ -51,6 +64,8 @@ constexpr int STALL_ITERATIONS = 15;
 /// while (reshaping a perturbed start) is not stalled.
 constexpr double STALL_OBJECTIVE_DECREASE = 0.1;
 constexpr double MATCH_TOLERANCE_REL = 1e-4;
+/// First-order optimality: the design gradient below this fraction of its value at the start.
+constexpr double OPTIMALITY_TOLERANCE = 1e-6;
 /// A stalled design whose inflated shape is further than this (relative to the diagonal, on average)
 /// from its rigid placement on the target is re-placed and continues.
 constexpr double REALIGN_TOLERANCE_REL = 1e-4;
@@ -184,15 +199,16 @@ class AdjointDesign {
     double damping = 0.0;  // Levenberg-Marquardt, relative to the mean diagonal
     int iteration = 0;
     double constraint_norm = constraints(z).norm();
-    result.message = "iteration limit reached";
+    stop_with(result, DesignStop::IterationLimit, "iteration limit reached");
     for (int outer = 0; outer < 30 && iteration < m_options.max_iterations; ++outer) {
       Eigen::VectorXd gradient;
       double value = lagrangian(z, &gradient);
       const double inner_tolerance = 1e-3 * gradient.norm();
       for (int inner = 0; inner < 20 && iteration < m_options.max_iterations; ++inner) {
-        if (m_options.cancel && m_options.cancel->cancelled()) result.message = "cancelled";
-        if (m_settings.deadline_s > 0 && now_s() > m_settings.deadline_s) result.message = "time limit reached";
-        if (result.message != "iteration limit reached") break;
+        if (m_options.cancel && m_options.cancel->cancelled()) stop_with(result, DesignStop::Cancelled, "cancelled");
+        if (m_settings.deadline_s > 0 && now_s() > m_settings.deadline_s)
+          stop_with(result, DesignStop::TimeLimit, "time limit reached");
+        if (result.stop != DesignStop::IterationLimit) break;
         ++iteration;
         Eigen::SparseMatrix<double> hessian = gauss_newton_hessian(z, pressure, mu, free);
         const double diagonal = hessian.diagonal().mean();
@@ -214,7 +230,7 @@ class AdjointDesign {
           damping *= 10.0;
         }
         if (direction.size() == 0) {
-          result.message = "the Gauss-Newton system could not be factorized";
+          stop_with(result, DesignStop::Stalled, "stalled: the Gauss-Newton system could not be factorized");
           break;
         }
         // Trust region: no vertex moves more than 2% of the target's size per step.
@@ -244,7 +260,7 @@ class AdjointDesign {
         }
         if (!accepted || gradient.norm() <= inner_tolerance) break;
       }
-      if (result.message != "iteration limit reached") break;
+      if (result.stop != DesignStop::IterationLimit) break;
       update_max_volume_term(z.head(n), start_distance, result);
       const Eigen::VectorXd c = constraints(z);
       const double new_norm = c.norm();
@@ -256,8 +272,8 @@ class AdjointDesign {
       }
       lagrangian(z, &gradient);
       if (new_norm <= 1e-6 * force_scale && gradient.norm() < 1e-4 * force_scale) {
-        result.converged = true;
-        result.message = "converged";
+        stop_with(result, DesignStop::Optimal,
+                  "optimal: force residual below 1e-6 and Lagrangian gradient below 1e-4 of the force scale");
         break;
       }
     }
@@ -272,10 +288,9 @@ class AdjointDesign {
     m_last_report = m_solver.solve_volume(x, inflated_pressure, m_target_volume, settings);
     m_x = x;
     m_pressure = inflated_pressure;
-    if (!m_last_report.converged) {
-      result.converged = false;
+    m_final_equilibrium = m_last_report.converged;
+    if (!m_last_report.converged)
       result.message += "; the final rest shape did not reach equilibrium (" + m_last_report.message + ")";
-    }
     return finish(result, rest);
   }
 
@@ -362,9 +377,10 @@ class AdjointDesign {
     Eigen::VectorXd gradient;
     double objective = objective_value(rest, m_x);
     if (!objective_gradient(rest, gradient)) {
-      result.message = "the adjoint system could not be factorized at the start";
+      stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized at the start");
       return finish(result, rest);
     }
+    const double initial_gradient_norm = gradient.norm();
     const double initial_objective = objective;
     build_preconditioner();
     debug_time("first gradient and preconditioner");
@@ -375,14 +391,14 @@ class AdjointDesign {
     int stall_iteration = 0;
     const double max_radius = 0.02 * result.bbox_diag_mm;  // mm
     double radius = max_radius;
-    result.message = "iteration limit reached";
+    stop_with(result, DesignStop::IterationLimit, "iteration limit reached");
     for (int iteration = 1; iteration <= m_options.max_iterations; ++iteration) {
       if (m_options.cancel && m_options.cancel->cancelled()) {
-        result.message = "cancelled";
+        stop_with(result, DesignStop::Cancelled, "cancelled");
         break;
       }
       if (m_settings.deadline_s > 0 && now_s() > m_settings.deadline_s) {
-        result.message = "time limit reached";
+        stop_with(result, DesignStop::TimeLimit, "time limit reached");
         break;
       }
       Eigen::VectorXd direction = -lbfgs_apply(memory, gradient);
@@ -428,15 +444,24 @@ class AdjointDesign {
       }
       if (!accepted) {
         if (stopped()) {
-          result.message = m_last_report.message;
+          stop_with(result, m_last_report.message == "cancelled" ? DesignStop::Cancelled : DesignStop::TimeLimit,
+                    m_last_report.message);
           break;
         }
         if (!memory.empty()) {  // a stale curvature model: restart from steepest descent
           memory.clear();
           continue;
         }
-        result.converged = true;
-        result.message = "converged: no further decrease along the steepest descent";
+        // A failed line search is optimality only where the gradient has vanished; elsewhere it is a stall
+        // (a wrinkling region no trial step could balance, say), and says so.
+        if (gradient.norm() <= OPTIMALITY_TOLERANCE * initial_gradient_norm) {
+          stop_with(result, DesignStop::Optimal, "optimal: the design gradient fell below " +
+                                                     format_fraction(OPTIMALITY_TOLERANCE) + " of its start value");
+        } else {
+          stop_with(result, DesignStop::Stalled,
+                    "stalled: no decrease along the steepest descent (design gradient still " +
+                        format_fraction(gradient.norm() / initial_gradient_norm) + " of its start value)");
+        }
         break;
       }
       radius = t < first_t ? t * largest : std::min(max_radius, 2.0 * radius);
@@ -454,7 +479,7 @@ class AdjointDesign {
       // The line search already evaluated this point; only a changed set of colliding pairs alters it.
       objective = colliding || was_colliding ? objective_value(rest, m_x) : trial_objective;
       if (!objective_gradient(rest, new_gradient)) {
-        result.message = "the adjoint system could not be factorized";
+        stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized");
         break;
       }
       debug_time("gradient");
@@ -471,15 +496,18 @@ class AdjointDesign {
       debug_time("surface error");
       const double relative_decrease = -t * slope / std::max(initial_objective, 1e-300);
       small_decreases = relative_decrease < 1e-7 ? small_decreases + 1 : 0;
-      if (small_decreases >= 3 || objective <= 1e-14 * initial_objective) {
-        result.converged = true;
-        result.message = "converged";
+      if (stats.avg_rel < MATCH_TOLERANCE_REL) {
+        stop_with(result, DesignStop::Matched, "matched: the inflated shape matches the target to " +
+                                                   format_fraction(MATCH_TOLERANCE_REL) + " of its bounding-box diagonal");
         break;
       }
-      if (stats.avg_rel < MATCH_TOLERANCE_REL) {
-        result.converged = true;
-        result.message = "converged: the inflated shape matches the target to " + format_fraction(MATCH_TOLERANCE_REL) +
-                         " of its bounding-box diagonal";
+      if (objective <= 1e-14 * initial_objective || gradient.norm() <= OPTIMALITY_TOLERANCE * initial_gradient_norm) {
+        stop_with(result, DesignStop::Optimal, "optimal: the design gradient fell below " +
+                                                   format_fraction(OPTIMALITY_TOLERANCE) + " of its start value");
+        break;
+      }
+      if (small_decreases >= 3) {
+        stop_with(result, DesignStop::Stalled, "stalled: the objective fell by less than 1e-7 in 3 iterations");
         break;
       }
       if (stats.avg_mm < (1.0 - STALL_IMPROVEMENT) * stall_reference) {
@@ -497,13 +525,13 @@ class AdjointDesign {
         objective = objective_value(rest, m_x);
         stall_objective = objective;
         if (!objective_gradient(rest, gradient)) {
-          result.message = "the adjoint system could not be factorized";
+          stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized");
           break;
         }
       } else if (iteration - stall_iteration >= STALL_ITERATIONS) {
-        result.converged = true;
-        result.message = "converged: the surface error improved less than " + format_fraction(STALL_IMPROVEMENT) +
-                         " in the last " + std::to_string(STALL_ITERATIONS) + " iterations";
+        stop_with(result, DesignStop::Stalled, "stalled: the surface error improved less than " +
+                                                   format_fraction(STALL_IMPROVEMENT) + " in the last " +
+                                                   std::to_string(STALL_ITERATIONS) + " iterations");
         break;
       }
     }
@@ -630,8 +658,14 @@ class AdjointDesign {
         reached = next;
         continue;
       }
-      if (stopped() || step < 1e-3 * (m_target_volume - start_volume)) {
-        result.message = "the start shape could not be inflated to the target volume (" + m_last_report.message + ")";
+      if (stopped()) {
+        stop_with(result, m_last_report.message == "cancelled" ? DesignStop::Cancelled : DesignStop::TimeLimit,
+                  m_last_report.message + " while inflating the start");
+        return false;
+      }
+      if (step < 1e-3 * (m_target_volume - start_volume)) {
+        stop_with(result, DesignStop::StartFailed,
+                  "the start shape could not be inflated to the target volume (" + m_last_report.message + ")");
         return false;
       }
       step *= 0.5;
@@ -876,9 +910,25 @@ class AdjointDesign {
     m_options.progress(event);
   }
 
+  /// Sets the stop reason and its sentence.
+  static void stop_with(DesignResult& result, DesignStop stop, std::string message) {
+    result.stop = stop;
+    result.message = std::move(message);
+  }
+
+  /// The result's shapes and errors. Without an inflated start (start_failed, or stopped before it)
+  /// there is no design: the errors stay empty, the rest shape is the start, nothing is called converged.
   DesignResult& finish(DesignResult& result, const Eigen::VectorXd& rest) {
     result.rest = m_target;
     result.rest.vertices = unflatten(rest);
+    result.time_s = now_s() - m_start;
+    const bool inflated = !result.log.empty();
+    result.converged = inflated && m_final_equilibrium &&
+                       (result.stop == DesignStop::Matched || result.stop == DesignStop::Optimal);
+    if (!inflated) {
+      result.inflated = result.rest.vertices;
+      return result;
+    }
     result.inflated = rigid_align_to(unflatten(m_x), m_target.vertices);
     result.pressure_kpa = m_pressure / MPA_PER_KPA;
     result.volume_ratio = enclosed_volume(unflatten(m_x), m_target.faces) / rest_volume(rest);
@@ -890,7 +940,6 @@ class AdjointDesign {
     result.distance_energy = m_distance.value(m_x);
     m_model.set_rest_positions(result.rest.vertices);
     result.residual_norm = m_solver.residual(m_x, m_pressure).norm();
-    result.time_s = now_s() - m_start;
     return result;
   }
 
@@ -919,6 +968,7 @@ class AdjointDesign {
   double m_best_error = std::numeric_limits<double>::infinity();
   Eigen::VectorXd m_best_rest, m_best_x;
   double m_best_pressure = 0.0;
+  bool m_final_equilibrium = true;  ///< alm: whether the final rest shape's re-inflation converged
 };
 
 std::string options_problem(const TriMesh& target, const DesignOptions& options) {
@@ -951,6 +1001,7 @@ DesignResult design_balloon(const TriMesh& target, const DesignOptions& options)
   if (auto problem = options_problem(target, options); !problem.empty()) {
     DesignResult result;
     result.method = options.method;
+    result.stop = DesignStop::StartFailed;
     result.message = problem;
     result.rest = target;
     result.inflated = target.vertices;

@@ -53,8 +53,9 @@ def free_port():
 class Shard:
     """One balloon-server: gRPC and HTTP on fixed loopback ports (the balancer's config names them)."""
 
-    def __init__(self, name, server, scratch, tokens):
+    def __init__(self, name, server, scratch, tokens, public_origin):
         self.name, self.server, self.scratch, self.tokens = name, server, scratch, tokens
+        self.public_origin = public_origin  # the balancer's address: the Host the page's requests carry
         self.grpc_port, self.http_port = free_port(), free_port()
         self.db = os.path.join(scratch, f"{name}.db")
         self.process = None
@@ -68,7 +69,8 @@ class Shard:
         self.process = subprocess.Popen(
             [self.server, "--listen", self.grpc, "--http", f"127.0.0.1:{self.http_port}", "--db", self.db,
              "--shard-name", self.name, "--token-file", self.tokens, "--workers", "1",
-             "--drain-timeout", str(DRAIN_TIMEOUT_S), "--web-root", self.scratch],
+             "--drain-timeout", str(DRAIN_TIMEOUT_S), "--web-root", self.scratch,
+             "--http-allowed-origin", self.public_origin],
             stdout=subprocess.PIPE, stderr=log, text=True)
         # Both lines come in one write once the server listens; a server that fails closes its stdout.
         output = ""
@@ -87,8 +89,8 @@ class Shard:
 
 
 class Balancer:
-    def __init__(self, config, scratch, shards):
-        self.grpc_port, self.http_port, self.stats_port = free_port(), free_port(), free_port()
+    def __init__(self, config, scratch, shards, http_port):
+        self.grpc_port, self.http_port, self.stats_port = free_port(), http_port, free_port()
         env = dict(os.environ, BALLOON_LB_GRPC_BIND=f"127.0.0.1:{self.grpc_port}",
                    BALLOON_LB_HTTP_BIND=f"127.0.0.1:{self.http_port}",
                    BALLOON_LB_STATS_BIND=f"127.0.0.1:{self.stats_port}")
@@ -210,10 +212,12 @@ def main():
                                "--out", path], capture_output=True, text=True)
         check(made.returncode == 0, made.stderr)
 
-    shards = [Shard(name, options.server, scratch, tokens) for name in SHARDS]
+    balancer_http_port = free_port()
+    shards = [Shard(name, options.server, scratch, tokens, f"http://127.0.0.1:{balancer_http_port}")
+              for name in SHARDS]
     for shard in shards:
         shard.start()
-    balancer = Balancer(options.config, scratch, shards)
+    balancer = Balancer(options.config, scratch, shards, balancer_http_port)
     try:
         for i in range(len(shards)):
             balancer.wait_for(f"shard{i}", "UP")
