@@ -11,6 +11,7 @@
 #include <memory>
 #include <optional>
 
+#include "design/adjoint_sensitivity.hpp"
 #include "design/distance_energy.hpp"
 #include "design/self_collision.hpp"
 #include "design/surface_distance.hpp"
@@ -84,6 +85,13 @@ std::string format_fraction(double fraction) {
   return text;
 }
 
+/// A ratio as a short human string: 131.4 -> "131x", 0.002 -> "0.002x".
+std::string format_ratio(double ratio) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.3gx", ratio);
+  return text;
+}
+
 Positions scaled_about_centroid(const Positions& points, double scale) {
   const Eigen::RowVector3d center = points.colwise().mean();
   Positions scaled = (points.rowwise() - center) * scale;
@@ -104,6 +112,7 @@ class AdjointDesign {
         m_model(m_rest_mesh, options.material,
                 std::vector<double>(static_cast<size_t>(target.face_count()), options.thickness_mm)),
         m_solver(m_model, rigid_support(m_rest_mesh)),
+        m_sensitivity(m_model, m_solver),
         m_distance(target.vertices, target.faces, options.k_length, options.k_bending),
         m_surface(target),
         m_start_hinges(m_rest_mesh.vertices, target.faces, 0.0, REST_BENDING_WEIGHT * options.k_bending),
@@ -185,7 +194,7 @@ class AdjointDesign {
         m_distance.gradient(zz.tail(n), distance_gradient);
         distance_gradient += surface_gradient;
         gradient->resize(2 * n);
-        gradient->head(n) = rest_force_transpose(zz.head(n), zz.tail(n), w);
+        gradient->head(n) = m_sensitivity.mixed_product(zz.head(n), zz.tail(n), w, true);
         add_regularizer_gradient(zz.head(n), gradient->head(n));
         gradient->tail(n) = distance_gradient + m_solver.stiffness_times(zz.tail(n), pressure, w);
         for (Eigen::Index c2 = 0; c2 < 2 * n; ++c2)
@@ -315,11 +324,11 @@ class AdjointDesign {
     for (int f = 0; f < faces.rows(); ++f) {
       const fem::Vector9d rest_corners = m_model.corners(rest, f), x_corners = m_model.corners(x, f);
       const fem::Matrix9d mixed =
-          fem::membrane_mixed_derivative(m_options.material, m_options.thickness_mm, rest_corners, x_corners);
+          fem::membrane_mixed_derivative(m_model.material(), m_model.thickness(f), rest_corners, x_corners);
       double energy = 0.0;
       fem::Vector9d element_gradient;
       fem::Matrix9d stiffness;
-      fem::membrane_energy_gradient_hessian(m_options.material, m_options.thickness_mm,
+      fem::membrane_energy_gradient_hessian(m_model.material(), m_model.thickness(f),
                                             fem::make_rest_triangle(rest_corners), x_corners, energy,
                                             element_gradient, stiffness);
       stiffness -= pressure * fem::triangle_volume_hessian(x_corners);
@@ -420,7 +429,7 @@ class AdjointDesign {
       // just used: each trial starts Newton a second-order distance from its solution.
       Eigen::VectorXd response;
       double pressure_response = 0.0;
-      linear_response(rest, direction, response, pressure_response);
+      m_sensitivity.linear_response(direction, response, pressure_response);
       bool accepted = false;
       Eigen::VectorXd trial_rest, trial_x;
       double trial_pressure = 0.0, trial_objective = 0.0;
@@ -459,8 +468,8 @@ class AdjointDesign {
                                                      format_fraction(OPTIMALITY_TOLERANCE) + " of its start value");
         } else {
           stop_with(result, DesignStop::Stalled,
-                    "stalled: no decrease along the steepest descent (design gradient still " +
-                        format_fraction(gradient.norm() / initial_gradient_norm) + " of its start value)");
+                    "stalled: no decrease along the steepest descent (design gradient at " +
+                        format_ratio(gradient.norm() / initial_gradient_norm) + " its start value)");
         }
         break;
       }
@@ -619,7 +628,7 @@ class AdjointDesign {
   }
 
   bool stopped() const {
-    return m_last_report.message == "cancelled" || m_last_report.message == "time limit reached";
+    return m_last_report.stop == NewtonStop::Cancelled || m_last_report.stop == NewtonStop::TimeLimit;
   }
 
   /// Volume-controlled equilibrium of `rest` from (x, p); false when it does not converge.
@@ -771,21 +780,13 @@ class AdjointDesign {
   /// [K -v; -v^T 0] [lambda; mu] = [dE/dx; 0], gradient = -(d grad_x W / d rest)^T lambda.
   bool objective_gradient(const Eigen::VectorXd& rest, Eigen::VectorXd& gradient) {
     m_model.set_rest_positions(unflatten(rest));
-    if (!m_solver.factorize_exact(m_x, m_pressure)) return false;
+    if (!m_sensitivity.prepare(rest, m_x, m_pressure)) return false;
     Eigen::VectorXd distance_gradient;
     m_distance.gradient(m_x, distance_gradient);
     Eigen::VectorXd surface_gradient;
     surface_term(m_x, &surface_gradient);
     distance_gradient += surface_gradient;
-    m_volume_gradient = m_model.volume_gradient(m_x);
-    m_volume_response = m_solver.solve_with_factorization(m_volume_gradient);
-    const Eigen::VectorXd& v = m_volume_gradient;
-    const Eigen::VectorXd& b = m_volume_response;
-    const Eigen::VectorXd a = m_solver.solve_with_factorization(distance_gradient);
-    const double vb = v.dot(b);
-    if (!(std::abs(vb) > 0.0)) return false;
-    const Eigen::VectorXd lambda = a - (v.dot(a) / vb) * b;
-    gradient = -rest_force_transpose(rest, m_x, lambda);
+    gradient = m_sensitivity.gradient(distance_gradient);
     add_regularizer_gradient(rest, gradient);
     for (int c = 0; c < gradient.size(); ++c)
       if (!m_rest_free[static_cast<size_t>(c)]) gradient[c] = 0.0;
@@ -797,48 +798,6 @@ class AdjointDesign {
       if (!m_rest_free[static_cast<size_t>(c)]) w[c] = 0.0;
     gradient -= (gradient.dot(w) / w.squaredNorm()) * w;
     return gradient.allFinite();
-  }
-
-  /// sum over triangles of M_e s_e, or of M_e^T s_e with `transpose`, M_e = d grad_x W_e / d rest the
-  /// element's mixed derivative (9x9) at (rest, x): how the forces change with the rest shape (M s), and
-  /// how forces weighted by s change with it (M^T s).
-  Eigen::VectorXd mixed_product(const Eigen::VectorXd& rest, const Eigen::VectorXd& x, const Eigen::VectorXd& s,
-                                bool transpose) const {
-    Eigen::VectorXd out = Eigen::VectorXd::Zero(rest.size());
-    const Faces& faces = m_target.faces;
-    for (int f = 0; f < faces.rows(); ++f) {
-      const fem::Matrix9d mixed = fem::membrane_mixed_derivative(m_options.material, m_options.thickness_mm,
-                                                                 m_model.corners(rest, f), m_model.corners(x, f));
-      const fem::Vector9d corners = m_model.corners(s, f);
-      const fem::Vector9d product = transpose ? fem::Vector9d(mixed.transpose() * corners) : fem::Vector9d(mixed * corners);
-      for (int k = 0; k < 3; ++k) out.segment<3>(3 * faces(f, k)) += product.segment<3>(3 * k);
-    }
-    return out;
-  }
-
-  /// (d grad_x W / d rest)^T w: how forces weighted by w change with the rest shape.
-  Eigen::VectorXd rest_force_transpose(const Eigen::VectorXd& rest, const Eigen::VectorXd& x,
-                                       const Eigen::VectorXd& w) const {
-    return mixed_product(rest, x, w, true);
-  }
-
-  /// d(x, p) for a rest change `direction` at the current equilibrium, using the factorization (and v,
-  /// K^-1 v) that objective_gradient left there:
-  /// [K -v; -v^T 0] [dx; dp] = [-(d grad_x W / d rest) direction; 0].
-  void linear_response(const Eigen::VectorXd& rest, const Eigen::VectorXd& direction, Eigen::VectorXd& dx,
-                       double& dp) const {
-    const Eigen::VectorXd rhs = -mixed_product(rest, m_x, direction, false);
-    // v and K^-1 v at this equilibrium are the ones objective_gradient just computed.
-    const Eigen::VectorXd& v = m_volume_gradient;
-    const Eigen::VectorXd& b = m_volume_response;
-    const Eigen::VectorXd a = m_solver.solve_with_factorization(rhs);
-    const double vb = v.dot(b);
-    dp = std::abs(vb) > 0.0 ? -v.dot(a) / vb : 0.0;
-    dx = a + dp * b;
-    if (!dx.allFinite()) {
-      dx.setZero(rest.size());
-      dp = 0.0;
-    }
   }
 
   /// L-BFGS's initial inverse Hessian: the Gauss-Newton Hessian of E_dist at the start's inflation,
@@ -949,6 +908,7 @@ class AdjointDesign {
   TriMesh m_rest_mesh;
   fem::BalloonModel m_model;
   EquilibriumSolver m_solver;
+  AdjointSensitivity m_sensitivity;  ///< dx/drest at the current equilibrium: the gradient and the predictor
   DistanceEnergy m_distance;
   SurfaceDistance m_surface;
   std::unique_ptr<SelfCollision> m_collision;
@@ -963,7 +923,6 @@ class AdjointDesign {
   NewtonSettings m_settings;
   NewtonReport m_last_report;
   Eigen::VectorXd m_x;
-  Eigen::VectorXd m_volume_gradient, m_volume_response;  ///< v = dV/dx and K^-1 v at m_x (objective_gradient)
   double m_pressure = 0.0;
   double m_best_error = std::numeric_limits<double>::infinity();
   Eigen::VectorXd m_best_rest, m_best_x;

@@ -148,7 +148,7 @@ std::string check_ply_header(std::string_view bytes, const MeshReadLimits& limit
   if (header_end == std::string_view::npos) return {};  // assimp reports the missing header
   const std::string_view header = bytes.substr(0, header_end);
   const std::size_t body = bytes.size() - header_end;
-  for (const auto [name, limit] : {std::pair{std::string_view("vertex"), limits.max_vertices},
+  for (const auto& [name, limit] : {std::pair{std::string_view("vertex"), limits.max_vertices},
                                    std::pair{std::string_view("face"), limits.max_faces}}) {
     const std::string prefix = "element " + std::string(name) + " ";
     const std::size_t at = header.find(prefix);
