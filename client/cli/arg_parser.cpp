@@ -13,12 +13,25 @@ std::optional<std::string> ParsedArgs::get(const std::string& name) const {
   return it->second.back();
 }
 
-Result<ParsedArgs> parse_args(const std::vector<std::string>& args, const std::vector<OptionSpec>& specs) {
+namespace {
+
+/// parse_args and take_options in one: with `rest`, unknown options and positionals go there instead.
+Result<ParsedArgs> parse_known(const std::vector<std::string>& args, const std::vector<OptionSpec>& specs,
+                               std::vector<std::string>* rest) {
   ParsedArgs parsed;
   bool options_ended = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& word = args[i];
+    if (rest != nullptr && (options_ended || word == "--")) {
+      rest->push_back(word);  // `--` and what follows belong to the command
+      options_ended = true;
+      continue;
+    }
     if (options_ended || word.size() < 2 || word.rfind("--", 0) != 0) {
+      if (rest != nullptr) {
+        rest->push_back(word);
+        continue;
+      }
       if (!options_ended && word.size() >= 2 && word[0] == '-' && !(std::isdigit(static_cast<unsigned char>(word[1])) || word[1] == '.'))
         return fail("unknown option '" + word + "' (options start with --)");
       parsed.positionals.push_back(word);
@@ -37,7 +50,11 @@ Result<ParsedArgs> parse_args(const std::vector<std::string>& args, const std::v
     const OptionSpec* spec = nullptr;
     for (const OptionSpec& candidate : specs)
       if (candidate.name == name) spec = &candidate;
-    if (spec == nullptr) return fail("unknown option '--" + name + "'");
+    if (spec == nullptr) {
+      if (rest == nullptr) return fail("unknown option '--" + name + "'");
+      rest->push_back(word);
+      continue;
+    }
     if (!spec->repeatable && parsed.has(name)) return fail("option '--" + name + "' given more than once");
     std::string value;
     if (spec->takes_value) {
@@ -53,6 +70,17 @@ Result<ParsedArgs> parse_args(const std::vector<std::string>& args, const std::v
     parsed.options[name].push_back(value);
   }
   return parsed;
+}
+
+}  // namespace
+
+Result<ParsedArgs> parse_args(const std::vector<std::string>& args, const std::vector<OptionSpec>& specs) {
+  return parse_known(args, specs, nullptr);
+}
+
+Result<ParsedArgs> take_options(const std::vector<std::string>& args, const std::vector<OptionSpec>& specs,
+                                std::vector<std::string>* rest) {
+  return parse_known(args, specs, rest);
 }
 
 Result<double> parse_number(const std::string& option, const std::string& text) {

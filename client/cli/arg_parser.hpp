@@ -31,6 +31,13 @@ struct ParsedArgs {
 /// non-repeatable options are errors. `--` ends the options.
 Result<ParsedArgs> parse_args(const std::vector<std::string>& args, const std::vector<OptionSpec>& specs);
 
+/// Takes the options named in `specs` out of `args` wherever they stand (up to a `--`), and leaves every
+/// other word in `rest`, in order: how the global and job options are found before or after the
+/// command's own. Same errors as parse_args for the options it knows; a word after an unknown option is
+/// left as it is (the command's own parser decides whether it is that option's value).
+Result<ParsedArgs> take_options(const std::vector<std::string>& args, const std::vector<OptionSpec>& specs,
+                                std::vector<std::string>* rest);
+
 /// A finite number, or an error naming the option: "--pressure: 'abc' is not a number".
 Result<double> parse_number(const std::string& option, const std::string& text);
 /// An integer in [min_value, max_value], or an error naming the option.

@@ -1,5 +1,6 @@
 #include "cli_output.hpp"
 
+#include <google/protobuf/util/json_util.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -58,6 +59,15 @@ Result<bool> write_file_atomically(const std::string& path, const std::string& b
     return fail("cannot write '" + path + "': " + error.message());
   }
   return true;
+}
+
+std::string message_to_json(const google::protobuf::Message& message) {
+  std::string json;
+  google::protobuf::util::JsonPrintOptions options;
+  options.preserve_proto_field_names = true;
+  options.always_print_primitive_fields = true;
+  (void)google::protobuf::util::MessageToJsonString(message, &json, options);
+  return json;
 }
 
 }  // namespace balloon::cli

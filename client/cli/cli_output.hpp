@@ -3,6 +3,8 @@
 /// appear whole or not at all.
 #include <string>
 
+#include <google/protobuf/message.h>
+
 #include "mesh/tri_mesh.hpp"
 #include "result.hpp"
 
@@ -21,5 +23,8 @@ Result<bool> write_mesh_file(const TriMesh& mesh, const std::string& path);
 
 /// Writes `bytes` to `path` through a temporary file and a rename (no partial file on failure).
 Result<bool> write_file_atomically(const std::string& path, const std::string& bytes);
+
+/// A message as one line of protobuf JSON (proto field names, defaults printed): what --json prints.
+std::string message_to_json(const google::protobuf::Message& message);
 
 }  // namespace balloon::cli

@@ -22,6 +22,8 @@
 #include "material/material.hpp"
 #include "material_argument.hpp"
 #include "mesh/mesh_io.hpp"
+#include "job_command.hpp"
+#include "result_files.hpp"
 #include "service_connection.hpp"
 #include "simulate_request.hpp"
 
@@ -77,13 +79,13 @@ constexpr const char* HELP =
     "Progress: a bar with iteration, current average error and ETA on a terminal; plain lines on stderr\n"
     "otherwise. Exit codes: 0 converged, 2 bad input (one line on stderr names it, before any work),\n"
     "3 finished without converging (the files are still written: the best design found), 5 server\n"
-    "unreachable or busy, 6 not allowed, 8 the job failed, 130 interrupted (the job is cancelled),\n"
+    "unreachable or busy, 6 not allowed, 8 the job failed, 130 interrupted (the job keeps running),\n"
     "1 internal error.\n\n";
 
 std::vector<OptionSpec> design_option_specs() {
   return {{"material"}, {"thickness"}, {"size"},      {"resolution"}, {"scale"},
           {"volume-ratio"}, {"method"}, {"nozzle"},   {"max-time"},   {"tolerance-samples"},
-          {"out-dir"},  {"json", false}, {"help", false}};
+          {"out-dir"}};
 }
 
 /// Checks TARGET_MESH and the flags locally (so errors name the flag) and builds the request.
@@ -169,27 +171,6 @@ double number_field(const Struct& object, const std::string& key) {
   return value != nullptr ? value->number_value() : 0.0;
 }
 
-
-/// The convergence log from the report's parallel arrays.
-std::vector<ConvergenceSample> convergence_from_report(const Struct& report) {
-  std::vector<ConvergenceSample> log;
-  const Value* convergence = field(report, "convergence");
-  if (convergence == nullptr || !convergence->has_struct_value()) return log;
-  const Struct& columns = convergence->struct_value();
-  const auto column = [&](const char* key) {
-    std::vector<double> values;
-    if (const Value* array = field(columns, key); array != nullptr && array->has_list_value())
-      for (const Value& v : array->list_value().values()) values.push_back(v.number_value());
-    return values;
-  };
-  const std::vector<double> time = column("time_s"), iteration = column("iteration"), avg = column("avg_error_mm"),
-                            max = column("max_error_mm"), residual = column("residual_norm");
-  const std::size_t rows = std::min({time.size(), iteration.size(), avg.size(), max.size(), residual.size()});
-  for (std::size_t i = 0; i < rows; ++i)
-    log.push_back({time[i], static_cast<int>(std::lround(iteration[i])), avg[i], max[i], residual[i]});
-  return log;
-}
-
 std::string format(const char* pattern, double value) {
   char buffer[64];
   std::snprintf(buffer, sizeof(buffer), pattern, value);
@@ -238,137 +219,58 @@ std::string summary_from_report(const Struct& report, const std::string& out_dir
   return out.str();
 }
 
-/// On a terminal: a bar with iteration, average error and ETA; otherwise plain lines (ProgressPrinter).
-class DesignProgress {
- public:
-  DesignProgress(bool terminal, double max_time_s) : m_terminal(terminal), m_max_time_s(max_time_s), m_lines(true) {}
-  ~DesignProgress() {
-    if (m_open) std::fputc('\n', stderr);
-  }
-  void operator()(const v1::JobEvent& event) {
-    if (!m_terminal || !event.has_progress() || event.progress().phase() != "design") {
-      if (m_open) std::fputc('\n', stderr);
-      m_open = false;
-      m_lines(event);
-      return;
-    }
-    const v1::Progress& p = event.progress();
-    const int budget = DesignOptions{}.max_iterations;
-    double fraction = std::min(1.0, static_cast<double>(p.iteration()) / budget);
-    double eta = p.iteration() > 0 ? p.elapsed_s() / p.iteration() * std::max(0, budget - p.iteration()) : -1.0;
-    if (m_max_time_s > 0.0) {
-      fraction = std::max(fraction, std::min(1.0, p.elapsed_s() / m_max_time_s));
-      const double left = std::max(0.0, m_max_time_s - p.elapsed_s());
-      eta = eta < 0.0 ? left : std::min(eta, left);
-    }
-    constexpr int WIDTH = 30;
-    const int filled = static_cast<int>(std::lround(fraction * WIDTH));
-    std::string bar(static_cast<std::size_t>(filled), '#');
-    bar.append(static_cast<std::size_t>(WIDTH - filled), '-');
-    std::fprintf(stderr, "\r\033[K[%s] it %d  avg error %.3g mm  max %.3g mm  %.1f s  ETA %s", bar.c_str(),
-                 p.iteration(), p.avg_error_mm(), p.max_error_mm(), p.elapsed_s(),
-                 eta < 0.0 ? "?" : (format("%.0f", eta) + " s").c_str());
-    std::fflush(stderr);
-    m_open = true;
-  }
+std::string out_dir_of(const PreparedJob& job) {
+  return job.args.get("out-dir").value_or(std::filesystem::path(job.file_path).stem().string() + "-design");
+}
 
- private:
-  bool m_terminal;
-  double m_max_time_s;
-  ProgressPrinter m_lines;
-  bool m_open = false;
-};
+Result<PreparedJob> prepare_design(const std::vector<std::string>& args) {
+  Result<ParsedArgs> parsed = parse_args(args, design_option_specs());
+  if (!parsed) return fail(parsed.error());
+  Result<v1::SubmitJobRequest> request = design_request_from_args(*parsed);
+  if (!request) return fail(request.error());
+  PreparedJob job;
+  job.request = std::move(*request);
+  job.args = std::move(*parsed);
+  job.file_field = "target_mesh";
+  job.file_path = job.args.positionals.front();
+  return job;
+}
+
+std::string check_design_outputs(const PreparedJob& job) { return output_directory_problem(out_dir_of(job)); }
+
+int finish_design(ServiceConnection& connection, const PreparedJob& job, const std::string& job_id,
+                  const GlobalOptions& global) {
+  grpc::Status status;
+  Result<v1::JobResult> result = fetch_result(connection, job_id, v1::MESH_FORMAT_OBJ, &status);
+  if (!result) return report_error(COMMAND, result.error(), exit_code_for(status));
+  const std::string out_dir = out_dir_of(job);
+  Result<std::vector<std::string>> written = write_result_files(*result, out_dir, "obj", COMMAND);
+  if (!written) return report_error(COMMAND, written.error(), EXIT_INTERNAL);
+  if (global.json)
+    std::cout << result->report_json() << std::endl;
+  else
+    std::cout << design_summary(result->report_json(), out_dir) << std::flush;
+  return result->converged() ? EXIT_OK : EXIT_NOT_CONVERGED;
+}
 
 }  // namespace
 
-int run_design_command(const std::vector<std::string>& args) {
-  std::vector<OptionSpec> options = design_option_specs();
-  for (const OptionSpec& spec : connection_option_specs()) options.push_back(spec);
-  Result<ParsedArgs> parsed = parse_args(args, options);
-  if (!parsed) return report_error(COMMAND, parsed.error(), EXIT_BAD_INPUT);
-  if (parsed->has("help")) {
-    std::fputs(HELP, stdout);
-    std::fputs(connection_help(), stdout);
-    return EXIT_OK;
-  }
-  // Every local check comes before any connection, so the cheapest problems are reported first.
-  Result<v1::SubmitJobRequest> request = design_request_from_args(*parsed);
-  if (!request) return report_error(COMMAND, request.error(), EXIT_BAD_INPUT);
-  const std::string mesh_path = parsed->positionals.front();
-  const std::string out_dir =
-      parsed->get("out-dir").value_or(std::filesystem::path(mesh_path).stem().string() + "-design");
-  {
-    std::error_code error;
-    std::filesystem::create_directories(out_dir, error);
-    if (error || !std::filesystem::is_directory(out_dir))
-      return report_error(COMMAND, "--out-dir: cannot create directory '" + out_dir + "'", EXIT_BAD_INPUT);
-    if (::access(out_dir.c_str(), W_OK) != 0)
-      return report_error(COMMAND, "--out-dir: directory '" + out_dir + "' is not writable", EXIT_BAD_INPUT);
-  }
-
-  auto connection = ServiceConnection::open(connection_options(*parsed));
-  if (!connection) return report_error(COMMAND, connection.error(), EXIT_UNAVAILABLE);
-
-  v1::SubmitJobResponse submitted;
-  if (const grpc::Status status = (*connection)->submit(*request, &submitted); !status.ok())
-    return report_error(COMMAND, message_naming_file(status, "target_mesh", mesh_path), exit_code_for(status));
-  const std::string job_id = submitted.job().id();
-
-  DesignProgress progress(isatty(STDERR_FILENO) == 1, request->spec().design().max_time_s());
-  if (const int code = follow_to_completion(**connection, COMMAND, job_id,
-                                           [&](const v1::JobEvent& event) { progress(event); });
-      code != EXIT_OK)
-    return code;
-
-  v1::GetResultRequest result_request;
-  result_request.set_job_id(job_id);
-  result_request.set_format(v1::MESH_FORMAT_OBJ);
-  v1::JobResult result;
-  {
-    grpc::ClientContext context;
-    (*connection)->prepare(context);
-    const grpc::Status status = (*connection)->stub().GetResult(&context, result_request, &result);
-    if (!status.ok()) return report_error(COMMAND, status.error_message(), exit_code_for(status));
-  }
-
+std::string design_summary(const std::string& report_json, const std::string& out_dir) {
   Struct report;
-  if (!google::protobuf::util::JsonStringToMessage(result.report_json(), &report).ok())
-    return report_error(COMMAND, "the service returned an unreadable report", EXIT_INTERNAL);
-  const std::filesystem::path directory(out_dir);
-  const auto write = [&](const char* name, const std::string& bytes) -> std::string {
-    Result<bool> written = write_file_atomically((directory / name).string(), bytes);
-    return written ? std::string() : std::string(name) + ": " + written.error();
-  };
-  std::string problem;
-  if (problem = write("rest.obj", result.rest_mesh().data()); !problem.empty())
-    return report_error(COMMAND, problem, EXIT_INTERNAL);
-  if (problem = write("inflated.obj", result.inflated_mesh().data()); !problem.empty())
-    return report_error(COMMAND, problem, EXIT_INTERNAL);
-  if (problem = write("report.json", result.report_json() + "\n"); !problem.empty())
-    return report_error(COMMAND, problem, EXIT_INTERNAL);
-  if (problem = write("convergence.csv", jobs::convergence_csv(convergence_from_report(report))); !problem.empty())
-    return report_error(COMMAND, problem, EXIT_INTERNAL);
-  // The mold is built here from the stored rest mesh with the tube the job chose (jobs::mold_from_report
-  // is the one place that builds it, for the web gateway too), since the store keeps meshes and the report only.
-  if (const Value* mold = field(report, "mold"); mold != nullptr && mold->has_struct_value()) {
-    Result<TriMesh> rest = read_mesh_from_memory(result.rest_mesh().data(), "obj");
-    if (!rest) return report_error(COMMAND, "rest mesh from the service: " + rest.error(), EXIT_INTERNAL);
-    Result<TriMesh> built = jobs::mold_from_report(*rest, result.report_json());
-    if (!built) {
-      std::fprintf(stderr, "balloon design: warning: mold.stl not written: %s\n", built.error().c_str());
-    } else if (problem = write("mold.stl", write_mesh_to_memory(*built, "stl")); !problem.empty()) {
-      return report_error(COMMAND, problem, EXIT_INTERNAL);
-    }
-  } else {
-    std::error_code ignored;
-    std::filesystem::remove(directory / "mold.stl", ignored);  // never leave a stale mold from an earlier run
-  }
+  if (!google::protobuf::util::JsonStringToMessage(report_json, &report).ok()) return report_json + "\n";
+  std::string summary = summary_from_report(report, out_dir);
+  if (out_dir.empty()) summary.erase(summary.rfind("  written to"));
+  return summary;
+}
 
-  if (parsed->has("json"))
-    std::cout << result.report_json() << std::endl;
-  else
-    std::cout << summary_from_report(report, out_dir) << std::flush;
-  return result.converged() ? EXIT_OK : EXIT_NOT_CONVERGED;
+const JobCommand& design_job_command() {
+  static const JobCommand COMMAND_PARTS{"design", HELP, {"out-dir"}, prepare_design, check_design_outputs,
+                                        finish_design};
+  return COMMAND_PARTS;
+}
+
+int run_design_command(const std::vector<std::string>& args, const GlobalOptions& global) {
+  return run_job_command(design_job_command(), args, global, false);
 }
 
 }  // namespace balloon::cli

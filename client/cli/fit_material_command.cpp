@@ -4,13 +4,16 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <sstream>
 
 #include "cli_output.hpp"
 #include "commands.hpp"
 #include "exit_codes.hpp"
+#include "job_command.hpp"
 #include "job_watch.hpp"
+#include "result_files.hpp"
 #include "jobs/fit_job.hpp"
 #include "service_connection.hpp"
 
@@ -60,22 +63,15 @@ std::string base_name(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
-}  // namespace
+/// The fit's data as checked locally, and the --name to store it under: what `finish` needs.
+struct FitContext {
+  jobs::FitInput input;
+};
 
-int run_fit_material_command(const std::vector<std::string>& args) {
-  const std::string command = "fit-material";
-  if (args.empty()) {
-    std::fputs(HELP, stdout);
-    return EXIT_BAD_INPUT;
-  }
+Result<PreparedJob> prepare_fit_material(const std::vector<std::string>& args) {
   // First pass: pull out the per-file options (--test, --radius, --thickness) with their positions, and
   // hand everything else to the common parser.
-  std::vector<OptionSpec> specs = connection_option_specs();
-  specs.push_back({"model"});
-  specs.push_back({"name"});
-  specs.push_back({"plot"});
-  specs.push_back({"json", false});
-  specs.push_back({"help", false});
+  std::vector<OptionSpec> specs = {{"model"}, {"name"}, {"plot"}};
   std::vector<PlacedOption> tests, radii, thicknesses;
   std::vector<std::string> rest;
   size_t files = 0;
@@ -86,7 +82,7 @@ int run_fit_material_command(const std::vector<std::string>& args) {
     for (const char* option : {"--test", "--radius", "--thickness"}) {
       const std::string prefix = std::string(option) + "=";
       if (word == option) {
-        if (i + 1 >= args.size()) return report_error(command, std::string(option) + " needs a value", EXIT_BAD_INPUT);
+        if (i + 1 >= args.size()) return fail(std::string(option) + " needs a value");
         name = option;
         value = args[++i];
         placed = true;
@@ -110,114 +106,117 @@ int run_fit_material_command(const std::vector<std::string>& args) {
     }
   }
   Result<ParsedArgs> parsed = parse_args(rest, specs);
-  if (!parsed) return report_error(command, parsed.error(), EXIT_BAD_INPUT);
-  if (parsed->has("help")) {
-    std::fputs(HELP, stdout);
-    std::fputs(connection_help(), stdout);
-    return EXIT_OK;
-  }
-  if (parsed->positionals.empty()) return report_error(command, "expected at least one DATA.csv file", EXIT_BAD_INPUT);
-  if (!parsed->get("model")) return report_error(command, "missing --model (hart-smith, mooney-rivlin, neo-hookean or all)", EXIT_BAD_INPUT);
-  if (tests.empty()) return report_error(command, "missing --test (bulge, uniaxial, equibiaxial or pure-shear)", EXIT_BAD_INPUT);
-  if (auto plot = parsed->get("plot"); plot && plot->size() < 5)
-    return report_error(command, "--plot needs an .svg file name", EXIT_BAD_INPUT);
+  if (!parsed) return fail(parsed.error());
+  if (parsed->positionals.empty()) return fail("expected at least one DATA.csv file (see --help)");
+  if (!parsed->get("model")) return fail("missing --model (hart-smith, mooney-rivlin, neo-hookean or all)");
+  if (tests.empty()) return fail("missing --test (bulge, uniaxial, equibiaxial or pure-shear)");
+  if (auto plot = parsed->get("plot"); plot && plot->size() < 5) return fail("--plot needs an .svg file name");
 
   std::vector<jobs::FitDataFile> data;
   for (size_t f = 0; f < parsed->positionals.size(); ++f) {
     const std::string& path = parsed->positionals[f];
     Result<std::string> bytes = read_file(path);
-    if (!bytes) return report_error(command, bytes.error(), EXIT_BAD_INPUT);
+    if (!bytes) return fail(bytes.error());
     jobs::FitDataFile file;
     file.label = base_name(path);
     file.csv_text = std::move(*bytes);
     file.test = *placed_value(tests, f);
     if (auto radius = placed_value(radii, f)) {
       Result<double> number = parse_number("--radius", *radius);
-      if (!number) return report_error(command, number.error(), EXIT_BAD_INPUT);
+      if (!number) return fail(number.error());
       file.radius_mm = *number;
     }
     if (auto thickness = placed_value(thicknesses, f)) {
       Result<double> number = parse_number("--thickness", *thickness);
-      if (!number) return report_error(command, number.error(), EXIT_BAD_INPUT);
+      if (!number) return fail(number.error());
       file.thickness_mm = *number;
     }
     data.push_back(std::move(file));
   }
+  // The local checks give bad data its one-line error before anything connects.
   Result<jobs::FitInput> input = jobs::prepare_fit(data, *parsed->get("model"));
-  if (!input) return report_error(command, input.error(), EXIT_BAD_INPUT);
-  // The fit runs as a service job (embedded server by default); the local checks above give bad data
-  // its one-line error before anything connects.
-  auto connection = ServiceConnection::open(connection_options(*parsed));
-  if (!connection) return report_error(command, connection.error(), EXIT_UNAVAILABLE);
-  v1::SubmitJobRequest request;
-  v1::FitMaterialJob* job = request.mutable_spec()->mutable_fit_material();
+  if (!input) return fail(input.error());
+
+  PreparedJob job;
+  v1::FitMaterialJob* fit = job.request.mutable_spec()->mutable_fit_material();
   for (const jobs::FitDataFile& file : data) {
-    v1::MeasurementSet* set = job->add_data();
+    v1::MeasurementSet* set = fit->add_data();
     set->set_csv(file.csv_text);
     set->set_test(file.test);
     set->set_radius_mm(file.radius_mm);
     set->set_thickness_mm(file.thickness_mm);
     set->set_label(file.label);
   }
-  job->set_model(*parsed->get("model"));
-  const std::optional<std::string> name = parsed->get("name");
-  if (name) job->set_name(*name);
-  std::string job_id;
-  {
-    v1::SubmitJobResponse submitted;
-    const grpc::Status status = (*connection)->submit(request, &submitted);
-    if (!status.ok()) {
-      std::string message = status.error_message();
-      if (status.error_code() == grpc::StatusCode::PERMISSION_DENIED && name) message = "--name " + *name + ": " + message;
-      return report_error(command, message, exit_code_for(status));
-    }
-    job_id = submitted.job().id();
+  fit->set_model(*parsed->get("model"));
+  if (const auto name = parsed->get("name")) {
+    fit->set_name(*name);
+    // A refused name is the --name's problem: the service's message then starts with the field.
+    job.file_field = "name";
+    job.file_path = "--name " + *name;
   }
-  const WatchOutcome watched = watch_job(**connection, job_id, [](const v1::JobEvent&) {});
-  if (watched.interrupted) {
-    cancel_job(**connection, job_id);
-    return report_error(command, "interrupted; job " + job_id + " cancelled", EXIT_INTERRUPTED);
-  }
-  if (!watched.status.ok()) return report_error(command, watched.status.error_message(), exit_code_for(watched.status));
-  if (watched.state != v1::JOB_STATE_COMPLETED) {
-    // A fit fails on its data (exit 2, as when it ran in-process) unless the job was stopped from outside.
-    const bool stopped = watched.state == v1::JOB_STATE_CANCELLED || watched.message.rfind("time limit", 0) == 0;
-    return report_error(command, watched.message, stopped ? EXIT_JOB_FAILED : EXIT_BAD_INPUT);
-  }
-  v1::JobResult result;
+  job.args = std::move(*parsed);
+  job.context = std::make_shared<const FitContext>(FitContext{std::move(*input)});
+  return job;
+}
+
+std::string check_fit_outputs(const PreparedJob&) { return ""; }
+
+/// A fit fails on its data (exit 2, as when it ran in-process) unless it was stopped from outside.
+int fit_failed_exit_code(const std::string& message) {
+  return message.rfind("time limit", 0) == 0 ? EXIT_JOB_FAILED : EXIT_BAD_INPUT;
+}
+
+int finish_fit_material(ServiceConnection& connection, const PreparedJob& job, const std::string& job_id,
+                        const GlobalOptions& global) {
+  const std::string command = "fit-material";
+  const jobs::FitInput& input = std::any_cast<const std::shared_ptr<const FitContext>&>(job.context)->input;
+  grpc::Status status;
+  Result<v1::JobResult> result = fetch_result(connection, job_id, v1::MESH_FORMAT_UNSPECIFIED, &status);
+  if (!result) return report_error(command, result.error(), exit_code_for(status));
   v1::Job finished;
   {
-    grpc::ClientContext context;
-    (*connection)->prepare(context);
-    v1::GetResultRequest result_request;
-    result_request.set_job_id(job_id);
-    const grpc::Status status = (*connection)->stub().GetResult(&context, result_request, &result);
-    if (!status.ok()) return report_error(command, status.error_message(), exit_code_for(status));
     grpc::ClientContext job_context;
-    (*connection)->prepare(job_context);
+    connection.prepare(job_context);
     v1::GetJobRequest job_request;
     job_request.set_job_id(job_id);
-    if (!(*connection)->stub().GetJob(&job_context, job_request, &finished).ok()) finished.Clear();
+    if (!connection.stub().GetJob(&job_context, job_request, &finished).ok()) finished.Clear();
   }
   // The report carries every number; labels and tests come from the local input.
-  Result<jobs::FitOutcome> outcome = jobs::fit_outcome_from_json(*input, result.report_json());
+  Result<jobs::FitOutcome> outcome = jobs::fit_outcome_from_json(input, result->report_json());
   if (!outcome) return report_error(command, "job " + job_id + ": " + outcome.error(), EXIT_INTERNAL);
   if (finished.finished_ms() > 0 && finished.started_ms() > 0)
     outcome->time_s = 1e-3 * static_cast<double>(finished.finished_ms() - finished.started_ms());
 
-  if (auto plot = parsed->get("plot")) {
-    Result<bool> written = write_file_atomically(*plot, jobs::fit_plot_svg(*input, *outcome));
+  if (auto plot = job.args.get("plot")) {
+    Result<bool> written = write_file_atomically(*plot, jobs::fit_plot_svg(input, *outcome));
     if (!written) return report_error(command, written.error(), EXIT_INTERNAL);
   }
-  if (name && !parsed->has("json")) {
+  const std::optional<std::string> name = job.args.get("name");
+  if (name && !global.json) {
     const FitResult& best = outcome->fits[static_cast<size_t>(jobs::best_fit_index(*outcome))];
     std::printf("stored %s: %s\n", name->c_str(), material_spec(best.material).c_str());
   }
-  if (parsed->has("json"))
-    std::cout << jobs::fit_report_json(*input, *outcome) << std::endl;
+  if (global.json)
+    std::cout << jobs::fit_report_json(input, *outcome) << std::endl;
   else
-    std::cout << jobs::fit_summary_text(*input, *outcome);
+    std::cout << jobs::fit_summary_text(input, *outcome);
   return EXIT_OK;
+}
+
+}  // namespace
+
+const JobCommand& fit_material_job_command() {
+  static const JobCommand PARTS{"fit-material",       HELP, {"plot"}, prepare_fit_material, check_fit_outputs,
+                                finish_fit_material, fit_failed_exit_code};
+  return PARTS;
+}
+
+int run_fit_material_command(const std::vector<std::string>& args, const GlobalOptions& global) {
+  if (args.empty() && !global.help) {
+    std::fputs(HELP, stdout);
+    return EXIT_BAD_INPUT;
+  }
+  return run_job_command(fit_material_job_command(), args, global, false);
 }
 
 }  // namespace balloon::cli

@@ -10,14 +10,33 @@
 
 #include "cli_output.hpp"
 #include "exit_codes.hpp"
+#include "global_options.hpp"
 
 namespace balloon::cli {
 namespace {
 
-std::atomic<bool> g_interrupted{false};
-extern "C" void on_interrupt(int) { g_interrupted.store(true); }
+std::atomic<int> g_interrupts{0};
+extern "C" void on_interrupt(int) { g_interrupts.fetch_add(1); }
 
 }  // namespace
+
+InterruptCatcher::InterruptCatcher() {
+  g_interrupts.store(0);
+  m_previous = std::signal(SIGINT, on_interrupt);
+}
+
+InterruptCatcher::~InterruptCatcher() { std::signal(SIGINT, m_previous); }
+
+int InterruptCatcher::count() const { return g_interrupts.load(); }
+
+bool InterruptCatcher::wait_for(int presses, double seconds) const {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (count() < presses) {
+    if (std::chrono::steady_clock::now() >= deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return true;
+}
 
 void cancel_job(ServiceConnection& connection, const std::string& job_id) {
   grpc::ClientContext context;
@@ -44,7 +63,7 @@ bool is_final(balloon::v1::JobState state) {
          state == balloon::v1::JOB_STATE_CANCELLED;
 }
 
-WatchOutcome watch_job(ServiceConnection& connection, const std::string& job_id,
+WatchOutcome watch_job(ServiceConnection& connection, const std::string& job_id, const InterruptCatcher& interrupts,
                        const std::function<void(const balloon::v1::JobEvent&)>& on_event) {
   WatchOutcome outcome;
   grpc::ClientContext context;
@@ -52,13 +71,11 @@ WatchOutcome watch_job(ServiceConnection& connection, const std::string& job_id,
   balloon::v1::WatchJobRequest request;
   request.set_job_id(job_id);
 
-  g_interrupted.store(false);
-  const auto previous = std::signal(SIGINT, on_interrupt);
   std::atomic<bool> done{false};
   // A blocking Read cannot see a signal: this thread turns Ctrl-C into a cancelled call.
   std::thread monitor([&] {
     while (!done.load()) {
-      if (g_interrupted.load()) {
+      if (interrupts.count() > 0) {
         context.TryCancel();
         return;
       }
@@ -76,8 +93,7 @@ WatchOutcome watch_job(ServiceConnection& connection, const std::string& job_id,
   outcome.status = reader->Finish();
   done.store(true);
   monitor.join();
-  std::signal(SIGINT, previous);
-  outcome.interrupted = g_interrupted.load();
+  outcome.interrupted = interrupts.count() > 0;
   return outcome;
 }
 
@@ -113,13 +129,45 @@ void ProgressPrinter::operator()(const balloon::v1::JobEvent& event) {
   std::fflush(stderr);
 }
 
-int follow_to_completion(ServiceConnection& connection, const std::string& command, const std::string& job_id,
-                         const std::function<void(const balloon::v1::JobEvent&)>& on_event) {
-  const WatchOutcome outcome = watch_job(connection, job_id, on_event);
-  if (outcome.interrupted) {
+int handle_interrupt(ServiceConnection& connection, const std::string& command, const std::string& job_id,
+                     const InterruptPolicy& policy, const InterruptCatcher& interrupts) {
+  const std::string prefix = "balloon " + command + ": ";
+  if (policy.cancel) {
     cancel_job(connection, job_id);
-    return report_error(command, "interrupted; job " + job_id + " cancelled", EXIT_INTERRUPTED);
+    std::fprintf(stderr, "\n%sinterrupted; job %s cancelled\n", prefix.c_str(), job_id.c_str());
+    return EXIT_INTERRUPTED;
   }
+  // Detach: the job is the user's work, often minutes of it; a second Ctrl-C is the way to stop it.
+  const int presses = interrupts.count();
+  if (connection.embedded()) {
+    // The embedded server stops with this process: its shutdown puts the running job back in the queue
+    // of the local store, and the next command that runs jobs (jobs watch) recovers and runs it.
+    std::fprintf(stderr,
+                 "\n%sinterrupted; job %s stays queued in %s; resuming runs it again\n"
+                 "resume with: %s\n(Ctrl-C again within 1 s cancels it)\n",
+                 prefix.c_str(), job_id.c_str(), connection.database().c_str(),
+                 resume_command(policy.connection, job_id).c_str());
+  } else {
+    std::fprintf(stderr,
+                 "\n%sinterrupted; job %s keeps running on %s\n"
+                 "resume with: %s\n(Ctrl-C again within 1 s cancels it)\n",
+                 prefix.c_str(), job_id.c_str(), policy.connection.server.c_str(),
+                 resume_command(policy.connection, job_id).c_str());
+  }
+  std::fflush(stderr);
+  if (interrupts.count() > presses || interrupts.wait_for(presses + 1, 1.0)) {
+    cancel_job(connection, job_id);
+    std::fprintf(stderr, "%sjob %s cancelled\n", prefix.c_str(), job_id.c_str());
+  }
+  return EXIT_INTERRUPTED;
+}
+
+int follow_to_completion(ServiceConnection& connection, const std::string& command, const std::string& job_id,
+                         const InterruptPolicy& policy,
+                         const std::function<void(const balloon::v1::JobEvent&)>& on_event) {
+  const InterruptCatcher interrupts;
+  const WatchOutcome outcome = watch_job(connection, job_id, interrupts, on_event);
+  if (outcome.interrupted) return handle_interrupt(connection, command, job_id, policy, interrupts);
   if (!outcome.status.ok()) return report_error(command, outcome.status.error_message(), exit_code_for(outcome.status));
   if (outcome.state != balloon::v1::JOB_STATE_COMPLETED)
     return report_error(command, "job " + job_id + " " + state_name(outcome.state) + ": " + outcome.message,

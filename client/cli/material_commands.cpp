@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <iostream>
 
+#include "arg_parser.hpp"
 #include "cli_output.hpp"
 #include "commands.hpp"
 #include "exit_codes.hpp"
@@ -23,15 +24,6 @@ constexpr const char* HELP =
     "--material, e.g. hart-smith:G=0.1,k1=3e-4,k2=1.0 (moduli in MPa).\n\n"
     "Exit codes: 0 ok, 2 bad input, 4 no such material, 5 unreachable, 6 not allowed (presets).\n\n";
 
-std::string to_json(const google::protobuf::Message& message) {
-  std::string json;
-  google::protobuf::util::JsonPrintOptions options;
-  options.preserve_proto_field_names = true;
-  options.always_print_primitive_fields = true;
-  (void)google::protobuf::util::MessageToJsonString(message, &json, options);
-  return json;
-}
-
 void print_material(const v1::Material& material) {
   std::printf("%-16s %s%s\n", material.name().c_str(), material.spec().c_str(), material.preset() ? "  (preset)" : "");
   if (!material.description().empty()) std::printf("%-16s %s\n", "", material.description().c_str());
@@ -39,26 +31,16 @@ void print_material(const v1::Material& material) {
 
 }  // namespace
 
-int run_materials_command(const std::vector<std::string>& args) {
-  if (args.empty() || args.front() == "--help" || args.front() == "-h") {
+int run_materials_command(const std::vector<std::string>& args, const GlobalOptions& global) {
+  if (args.empty() || global.help) {
     std::fputs(HELP, stdout);
-    std::fputs(connection_help(), stdout);
-    return args.empty() ? EXIT_BAD_INPUT : EXIT_OK;
+    std::fputs(global_options_help(), stdout);
+    return args.empty() && !global.help ? EXIT_BAD_INPUT : EXIT_OK;
   }
   const std::string action = args.front();
   const std::string command = "materials " + action;
-  std::vector<OptionSpec> options = connection_option_specs();
-  options.push_back({"spec"});
-  options.push_back({"description"});
-  options.push_back({"json", false});
-  options.push_back({"help", false});
-  Result<ParsedArgs> parsed = parse_args({args.begin() + 1, args.end()}, options);
+  Result<ParsedArgs> parsed = parse_args({args.begin() + 1, args.end()}, {{"spec"}, {"description"}});
   if (!parsed) return report_error(command, parsed.error(), EXIT_BAD_INPUT);
-  if (parsed->has("help")) {
-    std::fputs(HELP, stdout);
-    std::fputs(connection_help(), stdout);
-    return EXIT_OK;
-  }
   if (action != "list" && action != "show" && action != "delete" && action != "put")
     return report_error("materials", "unknown action '" + action + "' (list, show, delete, put)", EXIT_BAD_INPUT);
   const bool needs_name = action != "list";
@@ -67,21 +49,21 @@ int run_materials_command(const std::vector<std::string>& args) {
     return report_error(command, "unexpected argument '" + parsed->positionals.front() + "'", EXIT_BAD_INPUT);
   if (action == "put" && !parsed->get("spec")) return report_error(command, "missing --spec SPEC", EXIT_BAD_INPUT);
 
-  ConnectionOptions connection_opts = connection_options(*parsed);
+  ConnectionOptions connection_opts = global.connection;
   connection_opts.run_jobs = false;
   auto connection = ServiceConnection::open(connection_opts);
   if (!connection) return report_error(command, connection.error(), EXIT_UNAVAILABLE);
   ServiceConnection& service = **connection;
   grpc::ClientContext context;
   service.prepare(context);
-  const bool json = parsed->has("json");
+  const bool json = global.json;
 
   if (action == "list") {
     v1::ListMaterialsResponse reply;
     const grpc::Status status = service.stub().ListMaterials(&context, v1::ListMaterialsRequest(), &reply);
     if (!status.ok()) return report_error(command, status.error_message(), exit_code_for(status));
     if (json)
-      std::cout << to_json(reply) << std::endl;
+      std::cout << message_to_json(reply) << std::endl;
     else
       for (const v1::Material& material : reply.materials()) print_material(material);
     return EXIT_OK;
@@ -111,7 +93,7 @@ int run_materials_command(const std::vector<std::string>& args) {
   }
   if (!status.ok()) return report_error(command, status.error_message(), exit_code_for(status));
   if (json)
-    std::cout << to_json(material) << std::endl;
+    std::cout << message_to_json(material) << std::endl;
   else
     print_material(material);
   return EXIT_OK;

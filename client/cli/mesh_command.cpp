@@ -28,18 +28,18 @@ constexpr const char* HELP =
     "Exit codes: 0 written, 2 bad input, 1 the file could not be written.\n";
 
 const std::vector<OptionSpec> OPTIONS = {
-    {"radius"}, {"subdivisions"}, {"out"}, {"json", false}, {"help", false},
+    {"radius"}, {"subdivisions"}, {"out"},
 };
 
 }  // namespace
 
-int run_mesh_command(const std::vector<std::string>& args) {
-  Result<ParsedArgs> parsed = parse_args(args, OPTIONS);
-  if (!parsed) return report_error(COMMAND, parsed.error(), EXIT_BAD_INPUT);
-  if (parsed->has("help")) {
+int run_mesh_command(const std::vector<std::string>& args, const GlobalOptions& global) {
+  if (global.help) {
     std::fputs(HELP, stdout);
     return EXIT_OK;
   }
+  Result<ParsedArgs> parsed = parse_args(args, OPTIONS);
+  if (!parsed) return report_error(COMMAND, parsed.error(), EXIT_BAD_INPUT);
   if (parsed->positionals.empty()) return report_error(COMMAND, "missing what to make (try: balloon mesh sphere --help)", EXIT_BAD_INPUT);
   if (parsed->positionals.front() != "sphere")
     return report_error(COMMAND, "unknown mesh kind '" + parsed->positionals.front() + "' (known: sphere)", EXIT_BAD_INPUT);
@@ -66,7 +66,7 @@ int run_mesh_command(const std::vector<std::string>& args) {
   Result<bool> written = write_mesh_file(sphere, *out_path);
   if (!written) return report_error(COMMAND, "--out: " + written.error(), EXIT_INTERNAL);
 
-  if (parsed->has("json")) {
+  if (global.json) {
     jobs::JsonWriter json;
     json.begin_object()
         .value("out", *out_path)

@@ -14,31 +14,6 @@
 
 namespace balloon::cli {
 
-std::vector<OptionSpec> connection_option_specs() {
-  return {{"server"}, {"token"}, {"db"}, {"tls", false}, {"tls-ca"}};
-}
-
-const char* connection_help() {
-  return "Connection (all commands that use the service):\n"
-         "  --server HOST:PORT  a balloon-server (env BALLOON_SERVER); default: an embedded in-process server\n"
-         "  --token TOKEN       bearer token for the server (env BALLOON_TOKEN)\n"
-         "  --tls               use TLS with the system's root certificates\n"
-         "  --tls-ca FILE       use TLS trusting the PEM certificate(s) in FILE\n"
-         "  --db PATH           embedded server's database [$XDG_DATA_HOME/balloon/balloon.db]\n";
-}
-
-ConnectionOptions connection_options(const ParsedArgs& args) {
-  ConnectionOptions options;
-  const char* server_env = std::getenv("BALLOON_SERVER");
-  const char* token_env = std::getenv("BALLOON_TOKEN");
-  options.server = args.get("server").value_or(server_env != nullptr ? server_env : "");
-  options.token = args.get("token").value_or(token_env != nullptr ? token_env : "");
-  options.db = args.get("db").value_or("");
-  options.tls_ca = args.get("tls-ca").value_or("");
-  options.tls = args.has("tls") || !options.tls_ca.empty();
-  return options;
-}
-
 std::string default_database_path() {
   std::filesystem::path base;
   if (const char* xdg = std::getenv("XDG_DATA_HOME"); xdg != nullptr && *xdg != '\0') {

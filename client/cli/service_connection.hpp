@@ -8,7 +8,6 @@
 
 #include <grpcpp/grpcpp.h>
 
-#include "arg_parser.hpp"
 #include "balloon/v1/balloon.grpc.pb.h"
 #include "result.hpp"
 
@@ -26,13 +25,6 @@ struct ConnectionOptions {
   bool tls = false;      ///< TLS with the system roots
   bool run_jobs = true;  ///< embedded server: start workers (commands that wait for jobs)
 };
-
-/// The options every service command accepts: --server, --token, --db, --tls, --tls-ca.
-std::vector<OptionSpec> connection_option_specs();
-/// Reads them (falling back to BALLOON_SERVER and BALLOON_TOKEN).
-ConnectionOptions connection_options(const ParsedArgs& args);
-/// The text documenting them, for each command's --help.
-const char* connection_help();
 
 /// The embedded server's default database: $XDG_DATA_HOME/balloon/balloon.db, else
 /// ~/.local/share/balloon/balloon.db.

@@ -11,7 +11,9 @@
 #include "cli_output.hpp"
 #include "commands.hpp"
 #include "exit_codes.hpp"
+#include "job_command.hpp"
 #include "job_watch.hpp"
+#include "result_files.hpp"
 #include "service_connection.hpp"
 #include "simulate_request.hpp"
 
@@ -44,7 +46,7 @@ constexpr const char* HELP =
     "material, material_name, thickness_mm, control, flipped_orientation, message.\n\n"
     "Exit codes: 0 converged, 2 bad input (one line on stderr names it), 3 not converged (the result is\n"
     "still printed, no --out file), 5 server unreachable or busy, 6 not allowed, 8 the job failed,\n"
-    "130 interrupted (the job is cancelled), 1 internal error.\n\n";
+    "130 interrupted (the job keeps running), 1 internal error.\n\n";
 
 double number_field(const google::protobuf::Struct& report, const std::string& key) {
   const auto it = report.fields().find(key);
@@ -94,70 +96,63 @@ std::string summary_from_report(const std::string& report_json) {
   return out.str();
 }
 
-}  // namespace
-
-int run_simulate_command(const std::vector<std::string>& args) {
+Result<PreparedJob> prepare_simulate(const std::vector<std::string>& args) {
   std::vector<OptionSpec> options = simulate_option_specs();
-  for (const OptionSpec& spec : connection_option_specs()) options.push_back(spec);
   options.push_back({"out"});
-  options.push_back({"json", false});
-  options.push_back({"help", false});
   Result<ParsedArgs> parsed = parse_args(args, options);
-  if (!parsed) return report_error(COMMAND, parsed.error(), EXIT_BAD_INPUT);
-  if (parsed->has("help")) {
-    std::fputs(HELP, stdout);
-    std::fputs(connection_help(), stdout);
-    return EXIT_OK;
-  }
-  // Every local check comes before any connection, so the cheapest problems are reported first.
-  const std::optional<std::string> out_path = parsed->get("out");
+  if (!parsed) return fail(parsed.error());
   Result<v1::SubmitJobRequest> request = simulate_request_from_args(*parsed);
-  if (!request) return report_error(COMMAND, request.error(), EXIT_BAD_INPUT);
-  if (out_path) {
-    if (const std::string problem = mesh_output_problem(*out_path); !problem.empty())
-      return report_error(COMMAND, "--out: " + problem, EXIT_BAD_INPUT);
+  if (!request) return fail(request.error());
+  PreparedJob job;
+  job.request = std::move(*request);
+  job.args = std::move(*parsed);
+  job.file_field = "rest_mesh";
+  job.file_path = job.args.positionals.front();
+  return job;
+}
+
+std::string check_simulate_outputs(const PreparedJob& job) {
+  if (const auto out_path = job.args.get("out")) {
+    if (const std::string problem = mesh_output_problem(*out_path); !problem.empty()) return "--out: " + problem;
   }
-  const std::string mesh_path = parsed->positionals.front();
+  return "";
+}
 
-  auto connection = ServiceConnection::open(connection_options(*parsed));
-  if (!connection) return report_error(COMMAND, connection.error(), EXIT_UNAVAILABLE);
+int finish_simulate(ServiceConnection& connection, const PreparedJob& job, const std::string& job_id,
+                    const GlobalOptions& global) {
+  const std::optional<std::string> out_path = job.args.get("out");
+  grpc::Status status;
+  Result<v1::JobResult> result =
+      fetch_result(connection, job_id, out_path ? mesh_format_from_path(*out_path) : v1::MESH_FORMAT_OBJ, &status);
+  if (!result) return report_error(COMMAND, result.error(), exit_code_for(status));
 
-  v1::SubmitJobResponse submitted;
-  if (const grpc::Status status = (*connection)->submit(*request, &submitted); !status.ok())
-    return report_error(COMMAND, message_naming_file(status, "rest_mesh", mesh_path), exit_code_for(status));
-  const std::string job_id = submitted.job().id();
-
-  ProgressPrinter printer(isatty(STDERR_FILENO) == 1);
-  if (const int code = follow_to_completion(**connection, COMMAND, job_id,
-                                           [&](const v1::JobEvent& event) { printer(event); });
-      code != EXIT_OK)
-    return code;
-
-  v1::GetResultRequest result_request;
-  result_request.set_job_id(job_id);
-  result_request.set_format(out_path ? mesh_format_from_path(*out_path) : v1::MESH_FORMAT_OBJ);
-  v1::JobResult result;
-  {
-    grpc::ClientContext context;
-    (*connection)->prepare(context);
-    const grpc::Status status = (*connection)->stub().GetResult(&context, result_request, &result);
-    if (!status.ok()) return report_error(COMMAND, status.error_message(), exit_code_for(status));
-  }
-
-  if (parsed->has("json"))
-    std::cout << result.report_json() << std::endl;
+  if (global.json)
+    std::cout << result->report_json() << std::endl;
   else
-    std::cout << summary_from_report(result.report_json()) << std::flush;
+    std::cout << summary_from_report(result->report_json()) << std::flush;
 
-  if (!result.converged()) {
+  if (!result->converged()) {
     if (out_path) std::fprintf(stderr, "balloon simulate: not converged; %s not written\n", out_path->c_str());
     return EXIT_NOT_CONVERGED;
   }
   if (out_path) {
-    Result<bool> written = write_file_atomically(*out_path, result.inflated_mesh().data());
+    Result<bool> written = write_file_atomically(*out_path, result->inflated_mesh().data());
     if (!written) return report_error(COMMAND, "--out: " + written.error(), EXIT_INTERNAL);
   }
   return EXIT_OK;
+}
+
+}  // namespace
+
+std::string simulate_summary(const std::string& report_json) { return summary_from_report(report_json); }
+
+const JobCommand& simulate_job_command() {
+  static const JobCommand PARTS{"simulate", HELP, {"out"}, prepare_simulate, check_simulate_outputs, finish_simulate};
+  return PARTS;
+}
+
+int run_simulate_command(const std::vector<std::string>& args, const GlobalOptions& global) {
+  return run_job_command(simulate_job_command(), args, global, false);
 }
 
 }  // namespace balloon::cli

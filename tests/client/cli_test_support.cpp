@@ -20,15 +20,30 @@ ScratchDir::~ScratchDir() {
   std::filesystem::remove_all(m_path, ignored);
 }
 
-ProcessResult run_balloon(const ScratchDir& scratch, const std::vector<std::string>& args,
-                          const std::map<std::string, std::string>& env) {
+namespace {
+
+/// The test's environment for the CLI: its data directory in `scratch`, no server or token from ours.
+std::map<std::string, std::string> balloon_environment(const ScratchDir& scratch,
+                                                       const std::map<std::string, std::string>& env) {
   std::map<std::string, std::string> full_env = {
       {"XDG_DATA_HOME", scratch.file("xdg-data")},
       {"BALLOON_SERVER", ""},
       {"BALLOON_TOKEN", ""},
   };
   for (const auto& [name, value] : env) full_env[name] = value;
-  return run_process(BALLOON_CLI_PATH, args, full_env);
+  return full_env;
+}
+
+}  // namespace
+
+ProcessResult run_balloon(const ScratchDir& scratch, const std::vector<std::string>& args,
+                          const std::map<std::string, std::string>& env) {
+  return run_process(BALLOON_CLI_PATH, args, balloon_environment(scratch, env));
+}
+
+std::unique_ptr<RunningProcess> start_balloon(const ScratchDir& scratch, const std::vector<std::string>& args,
+                                              const std::map<std::string, std::string>& env) {
+  return std::make_unique<RunningProcess>(BALLOON_CLI_PATH, args, balloon_environment(scratch, env));
 }
 
 std::optional<std::string> json_field(const std::string& json, const std::string& key) {

@@ -2,6 +2,7 @@
 /// Shared pieces of the CLI tests: the binary under test, a scratch directory, flat-JSON field lookup.
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,6 +28,10 @@ class ScratchDir {
 /// Runs the `balloon` binary with its data directory inside `scratch`, so tests never touch ~/.local.
 ProcessResult run_balloon(const ScratchDir& scratch, const std::vector<std::string>& args,
                           const std::map<std::string, std::string>& env = {});
+
+/// Starts the `balloon` binary as run_balloon does, without waiting for it.
+std::unique_ptr<RunningProcess> start_balloon(const ScratchDir& scratch, const std::vector<std::string>& args,
+                                              const std::map<std::string, std::string>& env = {});
 
 /// The raw text of a top-level member of a one-line JSON object: `"key":VALUE` -> VALUE
 /// (strings keep their quotes). Enough for our flat reports; nullopt if the key is absent.

@@ -1,0 +1,275 @@
+// Remote use as people work (issue 12), from outside: global flags before or after the command, fire
+// and forget (`submit KIND`, --detach), re-attaching (`jobs watch`), the same files from `jobs result` as
+// from `design`, and Ctrl-C that leaves a remote job running. Against a real balloon-server process.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <set>
+
+#include "cli_test_support.hpp"
+#include "mesh/icosphere.hpp"
+#include "mesh/mesh_io.hpp"
+#include "server_process.hpp"
+
+namespace balloon::testing {
+namespace {
+
+namespace v1 = balloon::v1;
+
+/// A bumpy icosphere (radius ~10 mm): `subdivisions` 2 designs in about a second, 4 (2562 vertices)
+/// runs long enough to be interrupted.
+void write_bumpy(const std::string& path, int subdivisions) {
+  TriMesh bumpy = make_icosphere(1.0, subdivisions);
+  for (int i = 0; i < bumpy.vertex_count(); ++i) {
+    const Eigen::Vector3d p = bumpy.vertices.row(i);
+    bumpy.vertices.row(i) = 10.0 * (1.0 + 0.08 * std::sin(3 * p.x()) * std::sin(2 * p.y()) * std::cos(4 * p.z())) * p;
+  }
+  ASSERT_TRUE(write_mesh(bumpy, path).ok());
+}
+
+std::set<std::string> file_names(const std::string& directory) {
+  std::set<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(directory)) names.insert(entry.path().filename().string());
+  return names;
+}
+
+/// The id in `text` after `prefix` ("j-" and 16 hex digits), or "".
+std::string job_id_in(const std::string& text) {
+  const auto at = text.find("j-");
+  return at == std::string::npos ? "" : text.substr(at, 18);
+}
+
+class RemoteJobs : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    s_scratch = new ScratchDir();
+    write_bumpy(s_scratch->file("bumpy.obj"), 2);
+    write_bumpy(s_scratch->file("bumpy4.obj"), 4);
+    s_server = new ServerProcess(s_scratch->file("server.db"), {"--workers", "2"});
+  }
+  static void TearDownTestSuite() {
+    delete s_server;
+    delete s_scratch;
+    s_server = nullptr;
+    s_scratch = nullptr;
+  }
+  static ProcessResult run(const std::vector<std::string>& args) { return run_balloon(*s_scratch, args); }
+  static std::string server() { return s_server->address(); }
+
+  static v1::Job get_job(const std::string& job_id) {
+    grpc::ClientContext context;
+    v1::GetJobRequest request;
+    request.set_job_id(job_id);
+    v1::Job job;
+    EXPECT_TRUE(s_server->stub()->GetJob(&context, request, &job).ok()) << job_id;
+    return job;
+  }
+  static void cancel(const std::string& job_id) {
+    grpc::ClientContext context;
+    v1::CancelJobRequest request;
+    request.set_job_id(job_id);
+    v1::Job job;
+    s_server->stub()->CancelJob(&context, request, &job);
+  }
+
+  static ScratchDir* s_scratch;
+  static ServerProcess* s_server;
+};
+ScratchDir* RemoteJobs::s_scratch = nullptr;
+ServerProcess* RemoteJobs::s_server = nullptr;
+
+TEST_F(RemoteJobs, GlobalFlagsWorkBeforeAndAfterTheCommand) {
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"--server", server(), "jobs", "list", "--json"},
+        std::vector<std::string>{"jobs", "list", "--server", server(), "--json"},
+        std::vector<std::string>{"--json", "jobs", "--server=" + server(), "list"}}) {
+    const ProcessResult listed = run(args);
+    EXPECT_EQ(listed.exit_code, 0) << args[0] << " " << args[1] << ": " << listed.err;
+    EXPECT_EQ(listed.out.rfind("{", 0), 0u) << listed.out;  // --json reached the command wherever it stood
+  }
+  // An unreachable --server before the command is used, not ignored: exit 5.
+  EXPECT_EQ(run({"--server", "127.0.0.1:1", "jobs", "list"}).exit_code, 5);
+
+  // --db before or after: the same embedded store.
+  const std::string db = s_scratch->file("flags.db");
+  ASSERT_EQ(run({"--db", db, "materials", "put", "soft", "--spec", "neo-hookean:mu=0.2"}).exit_code, 0);
+  const ProcessResult shown = run({"materials", "show", "soft", "--db", db, "--json"});
+  ASSERT_EQ(shown.exit_code, 0) << shown.err;
+  EXPECT_EQ(json_field(shown.out, "spec"), "\"neo-hookean:mu=0.2\"");
+  EXPECT_EQ(run({"materials", "show", "soft"}).exit_code, 4);  // the default store has no 'soft'
+
+  // --help before or after the command: the command's help.
+  for (const std::vector<std::string>& args : {std::vector<std::string>{"--help", "design"},
+                                               std::vector<std::string>{"design", "-h"},
+                                               std::vector<std::string>{"--help", "submit", "design"}}) {
+    const ProcessResult help = run(args);
+    EXPECT_EQ(help.exit_code, 0);
+    EXPECT_NE(help.out.find("TARGET_MESH"), std::string::npos) << help.out;
+    EXPECT_NE(help.out.find("--detach"), std::string::npos) << help.out;
+  }
+  const ProcessResult jobs_help = run({"jobs", "--help"});
+  EXPECT_NE(jobs_help.out.find("jobs watch"), std::string::npos);
+
+  // Errors name the flag: one line, exit 2.
+  const ProcessResult missing = run({"jobs", "list", "--server"});
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("--server"), std::string::npos) << missing.err;
+  const ProcessResult twice = run({"--server", server(), "jobs", "list", "--server", server()});
+  EXPECT_EQ(twice.exit_code, 2);
+  EXPECT_NE(twice.err.find("more than once"), std::string::npos) << twice.err;
+}
+
+TEST_F(RemoteJobs, SubmitDesignReturnsQueuedThenWatchAndResultWriteWhatDesignWrites) {
+  const std::vector<std::string> design_args = {s_scratch->file("bumpy.obj"), "--material", "silicone", "--resolution",
+                                                "0", "--max-time", "20"};
+  std::vector<std::string> submit = {"--server", server(), "submit", "design"};
+  submit.insert(submit.end(), design_args.begin(), design_args.end());
+  submit.push_back("--json");
+  const ProcessResult submitted = run(submit);
+  ASSERT_EQ(submitted.exit_code, 0) << submitted.err;
+  const auto lines = split_lines(submitted.out);
+  ASSERT_EQ(lines.size(), 1u) << submitted.out;
+  // The reply is the stored job, before any worker finished it.
+  const std::string state = json_field(lines[0], "state").value_or("");
+  EXPECT_TRUE(state == "\"JOB_STATE_QUEUED\"" || state == "\"JOB_STATE_RUNNING\"") << lines[0];
+  EXPECT_EQ(json_field(lines[0], "kind"), "\"JOB_KIND_DESIGN\"");
+  const std::string job_id = json_field(lines[0], "id").value_or("\"\"");
+  const std::string id = job_id.substr(1, job_id.size() - 2);
+  ASSERT_EQ(id.rfind("j-", 0), 0u) << lines[0];
+
+  const ProcessResult listed = run({"jobs", "list", "--server", server()});
+  ASSERT_EQ(listed.exit_code, 0) << listed.err;
+  EXPECT_NE(listed.out.find(id), std::string::npos) << listed.out;
+
+  const ProcessResult watched = run({"--server", server(), "jobs", "watch", id});
+  ASSERT_TRUE(watched.exit_code == 0 || watched.exit_code == 3) << watched.err;
+  EXPECT_NE(watched.err.find("completed"), std::string::npos) << watched.err;
+  EXPECT_NE(watched.out.find("iterations"), std::string::npos) << watched.out;  // ends with the design's summary
+  EXPECT_NE(watched.out.find("162 vertices"), std::string::npos) << watched.out;
+
+  const std::string from_result = s_scratch->file("from-result"), from_design = s_scratch->file("from-design");
+  const ProcessResult result = run({"--server", server(), "jobs", "result", id, "--out-dir", from_result});
+  ASSERT_TRUE(result.exit_code == 0 || result.exit_code == 3) << result.err;
+  std::vector<std::string> design = {"--server", server(), "design"};
+  design.insert(design.end(), design_args.begin(), design_args.end());
+  design.insert(design.end(), {"--out-dir", from_design});
+  const ProcessResult designed = run(design);
+  ASSERT_TRUE(designed.exit_code == 0 || designed.exit_code == 3) << designed.err;
+
+  const std::set<std::string> five = {"rest.obj", "inflated.obj", "mold.stl", "report.json", "convergence.csv"};
+  EXPECT_EQ(file_names(from_result), five);
+  EXPECT_EQ(file_names(from_design), five);
+  const Result<TriMesh> rest = read_mesh(from_result + "/rest.obj");
+  const Result<TriMesh> mold = read_mesh(from_result + "/mold.stl");
+  ASSERT_TRUE(rest.ok() && mold.ok());
+  EXPECT_EQ(rest->vertex_count(), 162);
+  EXPECT_GT(mold->face_count(), rest->face_count());  // the tube adds faces
+}
+
+TEST_F(RemoteJobs, EveryKindCanBeSubmittedOrDetached) {
+  ASSERT_EQ(run({"mesh", "sphere", "--radius", "10", "--subdivisions", "1", "--out", s_scratch->file("s.obj")}).exit_code, 0);
+  const std::string csv = std::string(BALLOON_TEST_DATA_DIR) + "/materials/treloar1944_et.csv";
+  const std::vector<std::vector<std::string>> commands = {
+      {"--server", server(), "submit", "simulate", s_scratch->file("s.obj"), "--material", "latex", "--volume-ratio", "2"},
+      {"--server", server(), "submit", s_scratch->file("s.obj"), "--material", "latex", "--volume-ratio", "2"},
+      {"simulate", s_scratch->file("s.obj"), "--material", "latex", "--volume-ratio", "2", "--detach", "--server", server()},
+      {"--server", server(), "submit", "fit-material", csv, "--test", "equibiaxial", "--model", "neo-hookean"},
+      {"--server", server(), "fit-material", csv, "--test", "equibiaxial", "--model", "neo-hookean", "--detach"},
+      {"--server", server(), "design", s_scratch->file("bumpy.obj"), "--material", "silicone", "--resolution", "0",
+       "--max-time", "5", "--priority", "-5", "--detach"}};
+  for (const auto& args : commands) {
+    const ProcessResult submitted = run(args);
+    ASSERT_EQ(submitted.exit_code, 0) << args[2] << " " << args[3] << ": " << submitted.err;
+    const auto lines = split_lines(submitted.out);
+    ASSERT_EQ(lines.size(), 1u) << submitted.out;
+    EXPECT_EQ(lines[0].rfind("j-", 0), 0u) << lines[0];
+    const v1::Job job = get_job(lines[0]);
+    EXPECT_NE(job.state(), v1::JOB_STATE_UNSPECIFIED);
+    if (job.kind() == v1::JOB_KIND_DESIGN) {
+      EXPECT_EQ(job.priority(), -5);
+      cancel(lines[0]);  // nothing to wait for
+    }
+  }
+  // Bad input is refused before anything is queued, named as the command names it.
+  const ProcessResult bad = run({"--server", server(), "submit", "design", s_scratch->file("bumpy.obj"), "--material",
+                                 "silicone", "--scale", "0"});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("scale"), std::string::npos) << bad.err;
+  EXPECT_EQ(run({"--server", server(), "design", s_scratch->file("bumpy.obj"), "--material", "silicone", "--detach",
+                 "--cancel-on-interrupt"})
+                .exit_code,
+            2);
+}
+
+TEST_F(RemoteJobs, CtrlCLeavesTheRemoteDesignRunningAndPrintsHowToResume) {
+  auto cli = start_balloon(*s_scratch, {"--server", server(), "design", s_scratch->file("bumpy4.obj"), "--material",
+                                        "silicone", "--resolution", "0", "--max-time", "60", "--out-dir",
+                                        s_scratch->file("interrupted")});
+  // A progress line: the job runs on the server and the CLI follows it.
+  ASSERT_TRUE(cli->wait_for_stderr(" s] ", 60.0)) << cli->so_far().err;
+  cli->send_signal(SIGINT);
+  const ProcessResult ended = cli->wait();
+  EXPECT_EQ(ended.exit_code, 130) << ended.err;
+  const std::string id = job_id_in(ended.err);
+  ASSERT_FALSE(id.empty()) << ended.err;
+  EXPECT_NE(ended.err.find("balloon --server " + server() + " jobs watch " + id), std::string::npos) << ended.err;
+  EXPECT_EQ(get_job(id).state(), v1::JOB_STATE_RUNNING);
+
+  // Re-attached, the watch sees the same job's progress; Ctrl-C with --cancel-on-interrupt cancels it.
+  auto watch = start_balloon(*s_scratch, {"jobs", "watch", id, "--server", server(), "--cancel-on-interrupt"});
+  ASSERT_TRUE(watch->wait_for_stderr(id + " [", 60.0)) << watch->so_far().err;
+  watch->send_signal(SIGINT);
+  const ProcessResult cancelled = watch->wait();
+  EXPECT_EQ(cancelled.exit_code, 130) << cancelled.err;
+  EXPECT_NE(cancelled.err.find("cancelled"), std::string::npos) << cancelled.err;
+  EXPECT_EQ(get_job(id).state(), v1::JOB_STATE_CANCELLED);
+}
+
+TEST_F(RemoteJobs, ASecondCtrlCCancels) {
+  auto cli = start_balloon(*s_scratch, {"--server", server(), "design", s_scratch->file("bumpy4.obj"), "--material",
+                                        "silicone", "--resolution", "0", "--max-time", "60", "--out-dir",
+                                        s_scratch->file("twice")});
+  ASSERT_TRUE(cli->wait_for_stderr(" s] ", 60.0)) << cli->so_far().err;
+  cli->send_signal(SIGINT);
+  // The detach message invites a second Ctrl-C within a second.
+  ASSERT_TRUE(cli->wait_for_stderr("Ctrl-C again", 10.0)) << cli->so_far().err;
+  cli->send_signal(SIGINT);
+  const ProcessResult ended = cli->wait();
+  EXPECT_EQ(ended.exit_code, 130) << ended.err;
+  const std::string id = job_id_in(ended.err);
+  ASSERT_FALSE(id.empty()) << ended.err;
+  EXPECT_EQ(get_job(id).state(), v1::JOB_STATE_CANCELLED) << ended.err;
+}
+
+TEST_F(RemoteJobs, CtrlCOnTheEmbeddedServerLeavesTheJobInTheStoreAndJobsWatchRunsIt) {
+  const std::string db = s_scratch->file("embedded.db");
+  auto cli = start_balloon(*s_scratch, {"design", s_scratch->file("bumpy4.obj"), "--material", "silicone",
+                                        "--resolution", "0", "--max-time", "60", "--db", db, "--out-dir",
+                                        s_scratch->file("embedded-out")});
+  ASSERT_TRUE(cli->wait_for_stderr(" s] ", 60.0)) << cli->so_far().err;
+  cli->send_signal(SIGINT);
+  const ProcessResult ended = cli->wait();
+  EXPECT_EQ(ended.exit_code, 130) << ended.err;
+  const std::string id = job_id_in(ended.err);
+  ASSERT_FALSE(id.empty()) << ended.err;
+  EXPECT_NE(ended.err.find("balloon --db " + db + " jobs watch " + id), std::string::npos) << ended.err;
+  const ProcessResult shown = run({"jobs", "show", id, "--db", db, "--json"});
+  EXPECT_EQ(json_field(shown.out, "state"), "\"JOB_STATE_QUEUED\"") << shown.out;
+
+  // `jobs watch` starts the embedded server, which recovers the job and runs it again: its progress
+  // shows, and its second attempt is recorded (then cancelled here, to keep the test short).
+  auto resumed = start_balloon(*s_scratch, {"--db", db, "jobs", "watch", id, "--cancel-on-interrupt"});
+  ASSERT_TRUE(resumed->wait_for_stderr(id + " [", 60.0)) << resumed->so_far().err;
+  resumed->send_signal(SIGINT);
+  const ProcessResult stopped = resumed->wait();
+  EXPECT_EQ(stopped.exit_code, 130) << stopped.err;
+  const ProcessResult after = run({"jobs", "show", id, "--db", db, "--json"});
+  EXPECT_EQ(json_field(after.out, "state"), "\"JOB_STATE_CANCELLED\"") << after.out;
+  EXPECT_EQ(json_number_field(after.out, "attempts"), 2.0) << after.out;
+}
+
+}  // namespace
+}  // namespace balloon::testing
