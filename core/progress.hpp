@@ -29,6 +29,8 @@ struct ProgressEvent {
   double residual_norm = 0.0;     ///< force residual norm (N)
   double pressure_kpa = 0.0;      ///< current pressure (kPa)
   const Positions* shape = nullptr;  ///< current inflated positions (mm), set every K iterations, else null
+  /// Design only: the rest shape (mm) the event's iteration reached, for a checkpoint to resume from.
+  const Positions* rest_shape = nullptr;
 };
 
 /// Receives progress events; may be empty.

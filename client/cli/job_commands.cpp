@@ -45,7 +45,7 @@ constexpr const char* JOBS_HELP =
     "           then its summary on stdout (--json: one event per line on stdout). Ctrl-C stops watching\n"
     "           and leaves the job running (--cancel-on-interrupt, or a second Ctrl-C, cancels it).\n"
     "           With the embedded server (no --server) this also runs the job: a job left queued or\n"
-    "           interrupted in the local store starts again (from the beginning) and is followed\n"
+    "           interrupted in the local store runs again (a design from its last checkpoint) and is followed\n"
     "  cancel   cancel a queued or running job\n"
     "  delete   delete a finished job and its result (cancel a queued or running one first)\n"
     "  result   write a completed job's files into DIR, the same files its command writes:\n"

@@ -70,6 +70,8 @@ constexpr double OPTIMALITY_TOLERANCE = 1e-6;
 /// A stalled design whose inflated shape is further than this (relative to the diagonal, on average)
 /// from its rigid placement on the target is re-placed and continues.
 constexpr double REALIGN_TOLERANCE_REL = 1e-4;
+/// Rest shapes between the start and a checkpoint solved on the way to the checkpoint's equilibrium.
+constexpr int RESUME_STEPS = 4;
 /// Newton steps a line-search trial may take before the step is halved instead.
 constexpr int TRIAL_NEWTON_ITERATIONS = 10;
 
@@ -163,7 +165,7 @@ class AdjointDesign {
     const SurfaceDistanceStats baseline = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
     result.baseline_avg_error_mm = baseline.avg_mm;
     result.baseline_max_error_mm = baseline.max_mm;
-    record(result, 0, baseline);
+    record(result, 0, baseline, rest);
     remember_if_best(rest, baseline.avg_mm);
 
     const Eigen::Index n = rest.size();
@@ -265,7 +267,7 @@ class AdjointDesign {
           m_pressure = pressure;
           m_last_report.residual_norm = constraints(z).norm();
           const SurfaceDistanceStats stats = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
-          record(result, iteration, stats);
+          record(result, iteration, stats, z.head(n));
         }
         if (!accepted || gradient.norm() <= inner_tolerance) break;
       }
@@ -380,9 +382,20 @@ class AdjointDesign {
     const SurfaceDistanceStats baseline = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
     result.baseline_avg_error_mm = baseline.avg_mm;
     result.baseline_max_error_mm = baseline.max_mm;
-    record(result, 0, baseline);
+    record(result, 0, baseline, rest);
     remember_if_best(rest, baseline.avg_mm);
     debug_time("baseline error");
+    int first_iteration = 1;
+    double stall_reference = baseline.avg_mm;  // best surface error at the last real improvement (mm)
+    if (m_options.resume && resume_from(*m_options.resume, rest)) {
+      result.resumed_from_iteration = m_options.resume->iteration;
+      first_iteration = m_options.resume->iteration + 1;
+      const SurfaceDistanceStats resumed = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
+      record(result, m_options.resume->iteration, resumed, rest);
+      remember_if_best(rest, resumed.avg_mm);
+      stall_reference = resumed.avg_mm;
+      debug_time("resumed from the checkpoint");
+    }
     Eigen::VectorXd gradient;
     double objective = objective_value(rest, m_x);
     if (!objective_gradient(rest, gradient)) {
@@ -395,13 +408,12 @@ class AdjointDesign {
     debug_time("first gradient and preconditioner");
     std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> memory;  // (s, y) pairs for L-BFGS
     int small_decreases = 0;
-    double stall_reference = baseline.avg_mm;  // best surface error at the last real improvement (mm)
     double stall_objective = objective;         // objective at the last real improvement of either
-    int stall_iteration = 0;
+    int stall_iteration = first_iteration - 1;
     const double max_radius = 0.02 * result.bbox_diag_mm;  // mm
     double radius = max_radius;
     stop_with(result, DesignStop::IterationLimit, "iteration limit reached");
-    for (int iteration = 1; iteration <= m_options.max_iterations; ++iteration) {
+    for (int iteration = first_iteration; iteration <= m_options.max_iterations; ++iteration) {
       if (m_options.cancel && m_options.cancel->cancelled()) {
         stop_with(result, DesignStop::Cancelled, "cancelled");
         break;
@@ -499,7 +511,7 @@ class AdjointDesign {
       }
       gradient = new_gradient;
       const SurfaceDistanceStats stats = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
-      record(result, iteration, stats);
+      record(result, iteration, stats, rest);
       remember_if_best(rest, stats.avg_mm);
       result.iterations = iteration;
       debug_time("surface error");
@@ -687,6 +699,34 @@ class AdjointDesign {
     return true;
   }
 
+  /// Brings a checkpoint's rest shape (at this design's rest volume) to equilibrium from the inflated
+  /// start, through rest shapes blended from the start's in RESUME_STEPS steps. On success `rest`, m_x
+  /// and m_pressure are the checkpoint's; otherwise nothing changes.
+  bool resume_from(const DesignCheckpoint& checkpoint, Eigen::VectorXd& rest) {
+    if (checkpoint.rest.rows() != m_target.vertex_count() || checkpoint.rest.cols() != 3 ||
+        !checkpoint.rest.allFinite() || checkpoint.iteration < 1 || checkpoint.iteration >= m_options.max_iterations)
+      return false;
+    Eigen::VectorXd goal = flat(checkpoint.rest);
+    for (int c = 0; c < goal.size(); ++c)
+      if (!m_rest_free[static_cast<size_t>(c)]) goal[c] = rest[c];  // the nozzle stays where the start has it
+    goal = keep_rest_volume(goal, rest_volume(rest));
+    Eigen::VectorXd x = m_x;
+    double pressure = m_pressure;
+    for (int step = 1; step <= RESUME_STEPS; ++step) {
+      const double t = static_cast<double>(step) / RESUME_STEPS;
+      m_model.set_rest_positions(unflatten(Eigen::VectorXd((1.0 - t) * rest + t * goal)));
+      m_last_report = m_solver.solve_volume(x, pressure, m_target_volume, m_settings);
+      if (!m_last_report.converged) {
+        m_model.set_rest_positions(unflatten(rest));
+        return false;
+      }
+    }
+    rest = goal;
+    m_x = x;
+    m_pressure = pressure;
+    return true;
+  }
+
   double objective_value(const Eigen::VectorXd& rest, const Eigen::VectorXd& x) const {
     return m_distance.value(x) + surface_term(x, nullptr) + regularizer_value(rest);
   }
@@ -843,7 +883,7 @@ class AdjointDesign {
     return q;
   }
 
-  void record(DesignResult& result, int iteration, const SurfaceDistanceStats& stats) {
+  void record(DesignResult& result, int iteration, const SurfaceDistanceStats& stats, const Eigen::VectorXd& rest) {
     ConvergenceSample sample;
     sample.time_s = now_s() - m_start;
     sample.iteration = iteration;
@@ -866,6 +906,8 @@ class AdjointDesign {
       shape = rigid_align_to(unflatten(m_x), m_target.vertices);
       event.shape = &shape;
     }
+    const Positions rest_shape = unflatten(rest);
+    event.rest_shape = &rest_shape;
     m_options.progress(event);
   }
 

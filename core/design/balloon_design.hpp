@@ -32,6 +32,13 @@ enum class DesignStop {
 std::string design_stop_name(DesignStop stop);
 Result<DesignMethod> parse_design_method(const std::string& name);
 
+/// Where an interrupted design continues: its rest shape (#V x 3, mm, the target's connectivity) after
+/// `iteration` (taken from the progress events' rest_shape).
+struct DesignCheckpoint {
+  Positions rest;
+  int iteration = 0;
+};
+
 struct DesignOptions {
   Material material;
   double thickness_mm = 0.5;            ///< rest membrane thickness (mm)
@@ -54,6 +61,10 @@ struct DesignOptions {
   /// much as a 100% edge strain. It targets the error the result reports, which E_dist alone trades
   /// against hinge angles (bench: bunny 2.4x -> 3.5x better than the baseline). 0 switches it off.
   double k_surface = 100.0;
+  /// Continue from a checkpoint (adjoint only): the start is still inflated for the baseline, then the
+  /// checkpoint's rest shape is brought to equilibrium and the iterations go on from its count. A
+  /// checkpoint that does not fit the target or cannot be inflated is ignored (the design starts over).
+  std::optional<DesignCheckpoint> resume;
   int progress_mesh_every = 5;          ///< attach the inflated mesh to every K-th progress event
   ProgressCallback progress;            ///< optional; phases "start", "design"
   const CancelToken* cancel = nullptr;  ///< optional; checked between iterations
@@ -78,6 +89,7 @@ struct DesignResult {
   double pressure_kpa = 0.0;
   double volume_ratio = 0.0;           ///< inflated volume / rest volume
   int iterations = 0;
+  std::optional<int> resumed_from_iteration;  ///< set when the design continued from a checkpoint
   double time_s = 0.0;
   /// Inflated vertex to target surface (mm), and over the target's bounding-box diagonal. Empty when
   /// there is no design (start_failed): a design that was never inflated has no error, not zero.

@@ -150,7 +150,8 @@ Result<TriMesh> mold_from_report(const TriMesh& rest, const std::string& report_
   return design_mold(rest, parameters);
 }
 
-DesignOutcome run_design(const DesignInput& input, const RunControls& controls) {
+DesignOutcome run_design(const DesignInput& input, const RunControls& controls,
+                         const std::optional<DesignCheckpoint>& resume) {
   DesignOptions options;
   options.material = input.material;
   options.thickness_mm = input.parameters.thickness_mm;
@@ -163,6 +164,7 @@ DesignOutcome run_design(const DesignInput& input, const RunControls& controls) 
     options.max_time_s = options.max_time_s > 0.0 ? std::min(options.max_time_s, controls.max_time_s) : controls.max_time_s;
   options.progress = controls.progress;
   options.cancel = controls.cancel;
+  options.resume = resume;
 
   DesignOutcome outcome;
   outcome.result = design_balloon(input.target.mesh, options);
@@ -256,6 +258,7 @@ std::string design_report_json(const DesignInput& input, const DesignOutcome& ou
       .value("max_time_s", input.parameters.max_time_s)
       .value("cancelled", outcome.cancelled)
       .value("message", result.message);
+  if (result.resumed_from_iteration) json.value("resumed_from_iteration", *result.resumed_from_iteration);
 
   json.begin_object("preparation")
       .value("summary", target.summary)

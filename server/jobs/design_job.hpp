@@ -78,7 +78,9 @@ struct DesignOutcome {
 /// Runs the design (progress phases "design", then "tolerance"; the cancel token is checked between
 /// iterations), the tolerance check if asked, and finds the mold tube. controls.max_time_s, when set,
 /// caps the optimizer's budget. Never throws for non-convergence: that is `result.converged == false`.
-DesignOutcome run_design(const DesignInput& input, const RunControls& controls);
+/// `resume`: the design's last checkpoint when it runs again after an interruption (see DesignOptions).
+DesignOutcome run_design(const DesignInput& input, const RunControls& controls,
+                         const std::optional<DesignCheckpoint>& resume = std::nullopt);
 
 /// The mold for a rest shape (see build_mold): the service stores only meshes and the report, so the
 /// client builds mold.stl from the rest mesh and the report's "mold" object through this same function.

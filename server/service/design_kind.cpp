@@ -132,6 +132,15 @@ std::string design_summary(const DecodedDesign& design) {
   return summary;
 }
 
+/// The checkpoint an interrupted run of this job stored, decoded; none when absent or unreadable (the
+/// design then starts over, which is always correct).
+std::optional<DesignCheckpoint> checkpoint_of(const RunContext& context) {
+  if (!context.design_checkpoint) return std::nullopt;
+  Result<TriMesh> rest = store::decode_mesh_blob(context.design_checkpoint->second);
+  if (!rest) return std::nullopt;
+  return DesignCheckpoint{rest->vertices, context.design_checkpoint->first};
+}
+
 class DesignKind final : public JobKind {
  public:
   const char* name() const override { return "design"; }
@@ -162,7 +171,7 @@ class DesignKind final : public JobKind {
     jobs::RunControls controls;
     controls.cancel = &context.cancel;
     controls.progress = context.progress;
-    const jobs::DesignOutcome outcome = jobs::run_design(input, controls);
+    const jobs::DesignOutcome outcome = jobs::run_design(input, controls, checkpoint_of(context));
     if (context.cancel.cancelled()) return RunOutcome::stopped();
     if (outcome.result.rest.vertex_count() == 0)
       return RunOutcome::failed("the design produced no rest shape: " + outcome.result.message);

@@ -427,7 +427,7 @@ void JobHandler::run_job(std::int64_t row_id) {
     } else {
       RunContext context{*record, spec, active->token, progress_publisher(*record, spec),
                          [this, &record](const Faces& faces) { m_watches.set_connectivity(record->job_id, faces); },
-                         m_materials};
+                         m_materials, m_jobs.design_checkpoint(record->row_id)};
       finish_run(*record, *kind, *active, kind->run(context));
     }
   } catch (const std::exception& error) {
@@ -478,7 +478,7 @@ ProgressCallback JobHandler::progress_publisher(const store::JobRecord& record, 
   // The callback is copied into the solver's options: its counters live behind one shared pointer.
   struct State {
     int shape_events = 0;
-    std::chrono::steady_clock::time_point last_checkpoint{}, last_shape_checkpoint{};
+    std::chrono::steady_clock::time_point last_checkpoint{}, last_shape_checkpoint{}, last_rest_checkpoint{};
   };
   auto state = std::make_shared<State>();
   const std::int64_t row_id = record.row_id;
@@ -516,6 +516,13 @@ ProgressCallback JobHandler::progress_publisher(const store::JobRecord& record, 
       }
       m_jobs.append_progress(row_id, checkpoint, shape);
       state->last_checkpoint = now;
+    }
+    // A design's rest shape is what a restarted run continues from (issue 12): one kept per job.
+    if (progress.rest_shape != nullptr && progress.iteration > 0 &&
+        std::chrono::duration<double>(now - state->last_rest_checkpoint).count() >= SHAPE_CHECKPOINT_INTERVAL_S) {
+      m_jobs.save_design_checkpoint(row_id, progress.iteration,
+                                    store::encode_mesh_blob(TriMesh{*progress.rest_shape, Faces(0, 3)}));
+      state->last_rest_checkpoint = now;
     }
     m_watches.publish(job_id, event);
   };

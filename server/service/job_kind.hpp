@@ -3,7 +3,9 @@
 /// run on a worker and returned as a result. Adding a kind touches one implementation file and the
 /// list in job_kinds.cpp; the handler, the pool and the watch hub do not change.
 #include <functional>
+#include <optional>
 #include <string>
+#include <utility>
 
 #include "balloon/v1/balloon.pb.h"
 #include "mesh/tri_mesh.hpp"
@@ -37,6 +39,9 @@ struct RunContext {
   /// Gives the watch hub the triangles the first intermediate mesh carries.
   std::function<void(const Faces&)> set_connectivity;
   MaterialHandler& materials;
+  /// The job's last design checkpoint (iteration, rest shape as an encode_mesh_blob), if an earlier run of
+  /// it stored one before it was interrupted.
+  std::optional<std::pair<int, std::string>> design_checkpoint = std::nullopt;
 };
 
 /// How a run ended. The handler records it: one path for each outcome.

@@ -57,6 +57,10 @@ constexpr const char* INSERT_PROGRESS =
     "max_error_mm, recorded_ms, shape) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)";
 constexpr const char* SELECT_LATEST_SHAPE =
     "SELECT shape FROM progress WHERE job_row = ? AND shape IS NOT NULL ORDER BY id DESC LIMIT 1";
+constexpr const char* UPSERT_DESIGN_CHECKPOINT =
+    "INSERT OR REPLACE INTO design_checkpoints (job_row, iteration, rest_shape, recorded_ms) VALUES (?, ?, ?, ?)";
+constexpr const char* SELECT_DESIGN_CHECKPOINT =
+    "SELECT iteration, rest_shape FROM design_checkpoints WHERE job_row = ?";
 constexpr const char* DELETE_FINISHED_JOB =
     "DELETE FROM jobs WHERE id = ? AND state IN ('completed', 'failed', 'cancelled')";
 constexpr const char* DELETE_FINISHED_BEFORE =
@@ -256,6 +260,25 @@ std::optional<std::string> JobStore::latest_shape(std::int64_t row_id) {
   statement.bind(1, row_id);
   if (!statement.step()) return std::nullopt;
   return statement.column_blob(0);
+}
+
+void JobStore::save_design_checkpoint(std::int64_t row_id, int iteration, const std::string& rest_shape) {
+  std::lock_guard lock(m_store.mutex());
+  m_store.database()
+      .prepare(UPSERT_DESIGN_CHECKPOINT)
+      .bind(1, row_id)
+      .bind(2, iteration)
+      .bind_blob(3, rest_shape)
+      .bind(4, now_ms())
+      .run();
+}
+
+std::optional<std::pair<int, std::string>> JobStore::design_checkpoint(std::int64_t row_id) {
+  std::lock_guard lock(m_store.mutex());
+  Statement statement = m_store.database().prepare(SELECT_DESIGN_CHECKPOINT);
+  statement.bind(1, row_id);
+  if (!statement.step()) return std::nullopt;
+  return std::make_pair(statement.column_int(0), statement.column_blob(1));
 }
 
 int JobStore::progress_count(std::int64_t row_id) {

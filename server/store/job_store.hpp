@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "store/store.hpp"
@@ -103,6 +104,11 @@ class JobStore {
   std::optional<std::string> latest_shape(std::int64_t row_id);
   /// Number of progress checkpoints of a job.
   int progress_count(std::int64_t row_id);
+
+  /// Replaces the job's design checkpoint: its rest shape (an encode_mesh_blob, mm) after `iteration`.
+  void save_design_checkpoint(std::int64_t row_id, int iteration, const std::string& rest_shape);
+  /// The job's design checkpoint, if it has one: (iteration, rest shape blob).
+  std::optional<std::pair<int, std::string>> design_checkpoint(std::int64_t row_id);
 
   /// Deletes a finished job with its result and progress (ON DELETE CASCADE). False, deleting nothing, if
   /// the job is queued or running (or gone).

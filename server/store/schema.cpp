@@ -71,8 +71,18 @@ ALTER TABLE jobs ADD COLUMN request_id TEXT NOT NULL DEFAULT '';
 CREATE INDEX jobs_request ON jobs (owner, request_id, created_ms) WHERE request_id <> '';
 )sql";
 
+// Version 3: the latest resumable state of a running design (its rest shape after an iteration).
+constexpr const char* MIGRATION_3 = R"sql(
+CREATE TABLE design_checkpoints (
+  job_row INTEGER PRIMARY KEY REFERENCES jobs (id) ON DELETE CASCADE,
+  iteration INTEGER NOT NULL,
+  rest_shape BLOB NOT NULL,
+  recorded_ms INTEGER NOT NULL
+);
+)sql";
+
 const std::vector<const char*>& migrations() {
-  static const std::vector<const char*> list = {MIGRATION_1, MIGRATION_2};
+  static const std::vector<const char*> list = {MIGRATION_1, MIGRATION_2, MIGRATION_3};
   return list;
 }
 

@@ -5,6 +5,11 @@
 #include <signal.h>
 
 #include <cmath>
+#include <thread>
+#include <optional>
+#include <iterator>
+#include <fstream>
+#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <set>
@@ -40,6 +45,14 @@ std::set<std::string> file_names(const std::string& directory) {
 std::string job_id_in(const std::string& text) {
   const auto at = text.find("j-");
   return at == std::string::npos ? "" : text.substr(at, 18);
+}
+
+int get_attempts(ServerProcess& server, const std::string& job_id) {
+  grpc::ClientContext context;
+  v1::GetJobRequest request;
+  request.set_job_id(job_id);
+  v1::Job job;
+  return server.stub()->GetJob(&context, request, &job).ok() ? job.attempts() : -1;
 }
 
 class RemoteJobs : public ::testing::Test {
@@ -269,6 +282,59 @@ TEST_F(RemoteJobs, CtrlCOnTheEmbeddedServerLeavesTheJobInTheStoreAndJobsWatchRun
   const ProcessResult after = run({"jobs", "show", id, "--db", db, "--json"});
   EXPECT_EQ(json_field(after.out, "state"), "\"JOB_STATE_CANCELLED\"") << after.out;
   EXPECT_EQ(json_number_field(after.out, "attempts"), 2.0) << after.out;
+}
+
+// Issue 12's must-show: a design on a server killed with kill -9 continues, after the restart, from its
+// stored checkpoint (the iteration count keeps rising from where it was), finishes, and `jobs result`
+// writes the five files.
+TEST(RemoteJobsResume, AKilledServerResumesTheDesignFromItsCheckpoint) {
+  ScratchDir scratch;
+  write_bumpy(scratch.file("bumpy4.obj"), 4);
+  const std::string db = scratch.file("server.db");
+  auto server = std::make_unique<ServerProcess>(db, std::vector<std::string>{"--workers", "1"});
+  const ProcessResult submitted =
+      run_balloon(scratch, {"--server", server->address(), "submit", "design", scratch.file("bumpy4.obj"), "--material",
+                            "silicone", "--resolution", "0", "--max-time", "25"});
+  ASSERT_EQ(submitted.exit_code, 0) << submitted.err;
+  const std::string id = job_id_in(submitted.out);
+  ASSERT_FALSE(id.empty()) << submitted.out;
+
+  const auto iteration_now = [&](ServerProcess& on) {
+    grpc::ClientContext context;
+    v1::GetJobRequest request;
+    request.set_job_id(id);
+    v1::Job job;
+    return on.stub()->GetJob(&context, request, &job).ok() && job.last_progress().phase() == "design"
+               ? job.last_progress().iteration()
+               : 0;
+  };
+  // Some design iterations, and a second more so that the checkpoint (one a second) holds one of them.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (iteration_now(*server) < 3 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+  const int before_kill = iteration_now(*server);
+  ASSERT_GE(before_kill, 3) << "the design never got going";
+  EXPECT_EQ(server->stop(SIGKILL), 128 + SIGKILL);
+
+  server = std::make_unique<ServerProcess>(db, std::vector<std::string>{"--workers", "1"});
+  const ProcessResult watched = run_balloon(scratch, {"--server", server->address(), "jobs", "watch", id});
+  ASSERT_TRUE(watched.exit_code == 0 || watched.exit_code == 3) << watched.err;
+  const std::string out_dir = scratch.file("resumed");
+  const ProcessResult result = run_balloon(scratch, {"--server", server->address(), "jobs", "result", id, "--out-dir", out_dir});
+  ASSERT_TRUE(result.exit_code == 0 || result.exit_code == 3) << result.err;
+  EXPECT_EQ(file_names(out_dir), (std::set<std::string>{"rest.obj", "inflated.obj", "mold.stl", "report.json",
+                                                       "convergence.csv"}));
+  std::ifstream report_file(out_dir + "/report.json");
+  const std::string report{std::istreambuf_iterator<char>(report_file), std::istreambuf_iterator<char>()};
+  const std::optional<std::string> resumed = json_field(report, "resumed_from_iteration");
+  ASSERT_TRUE(resumed.has_value()) << "the design started over instead of resuming: " << report.substr(0, 400);
+  const int resumed_from = std::stoi(*resumed);
+  EXPECT_GE(resumed_from, 1);
+  EXPECT_LE(resumed_from, before_kill);
+  const int iterations = std::stoi(json_field(report, "iterations").value_or("0"));
+  EXPECT_GT(iterations, resumed_from) << "the count must keep rising from the checkpoint";
+  EXPECT_EQ(get_attempts(*server, id), 2);
 }
 
 }  // namespace
