@@ -347,8 +347,12 @@ def run_scenario(cli, shards, balancer, small, large, scratch):
                       json.dumps(design).encode()) as reply:
         drained_job = json.loads(reply.read())["job"]["id"]
     submitted[drained_job] = drained_tenant
-    wait_until(lambda: cli.json(["jobs", "show", drained_job], drained_tenant, lb)["state"] == "JOB_STATE_RUNNING", 30,
-               "the job to drain to run")
+    # Past a few design iterations, and a second more: the design has stored a checkpoint to resume from.
+    def design_iteration():
+        progress = cli.json(["jobs", "show", drained_job], drained_tenant, lb).get("last_progress", {})
+        return progress.get("iteration", 0) if progress.get("phase") == "design" else 0
+    wait_until(lambda: design_iteration() >= 2, 60, "the design to drain to iterate")
+    time.sleep(1.2)
     term_at = time.time()
     check(drained.stop(signal.SIGTERM) == 0, "the drained server did not exit cleanly")
     exit_s = time.time() - term_at
@@ -365,6 +369,13 @@ def run_scenario(cli, shards, balancer, small, large, scratch):
     check(watched.returncode in (0, 3), f"the drained job: exit {watched.returncode}: {watched.stderr[-400:]}")
     attempts = cli.json(["jobs", "show", drained_job], drained_tenant, lb)["attempts"]
     check(attempts == 2, f"the drained job ran {attempts} time(s), 2 expected (interrupted, then again)")
+    with http_request(f"http://127.0.0.1:{balancer.http_port}/api/v1/jobs/{drained_job}/files/report.json",
+                      TOKENS[drained_tenant]) as reply:
+        report = json.loads(reply.read())
+    check(report.get("resumed_from_iteration", 0) >= 1,
+          f"the drained design started over instead of resuming: resumed_from_iteration "
+          f"{report.get('resumed_from_iteration')}")
+    print(f"phase 3: the drained design resumed from iteration {report['resumed_from_iteration']}", flush=True)
 
     # 4. The HTTP gateway through the balancer: same shard as gRPC, SSE events, a file download.
     web = f"http://127.0.0.1:{balancer.http_port}/api/v1"
