@@ -7,7 +7,9 @@ One balloon-server on 127.0.0.1 (--workers 2, a token file with three tenants, o
 8 client threads each submit 20 small jobs (simulate of a small icosphere, 2-second designs of a 162-vertex
 sphere or ellipsoid, neo-Hookean fits of a Treloar CSV), each with its own request_id, retrying a call that
 failed with UNAVAILABLE with the SAME request_id. Meanwhile the server is killed with SIGKILL 20 times at
-seeded random moments, each time restarted at once on the same store and port. Afterwards, once nothing is
+seeded random moments, each time restarted at once on the same store and port; every 4th kill lands 5-50 ms
+after 8 extra submissions went out at once, so some are stored but never answered and their retries must get
+the stored job back (the count of those is printed, not asserted: it depends on timing). Afterwards, once nothing is
 QUEUED or RUNNING: every accepted request maps to exactly one job, every job was submitted by a client, and
 every job ended COMPLETED (with a stored result), FAILED or CANCELLED (with a reason). Then a job that is
 running at each of three kills ends FAILED with "crashed the server 3 times" (default --max-attempts 3).
@@ -31,6 +33,8 @@ SERVICE = "/balloon.v1.BalloonService/"
 TENANTS = ["alice", "bob", "carol"]
 TOKENS = {t: f"token-of-{t}-0123456789abcdef" for t in TENANTS}
 CLIENTS, JOBS_PER_CLIENT, KILLS = 8, 20, 20
+BURST_EVERY, BURST_SIZE = 4, 8  # every 4th kill lands 5-50 ms after 8 extra submissions were sent at once
+EXPECTED_JOBS = CLIENTS * JOBS_PER_CLIENT + KILLS // BURST_EVERY * BURST_SIZE
 SUBMIT_RETRY_S = 90.0   # a request still unanswered after this long is a failure of the test
 DRAIN_TIMEOUT_S = 150.0  # after the last restart, every job must have ended within this
 FINAL = ("JOB_STATE_COMPLETED", "JOB_STATE_FAILED", "JOB_STATE_CANCELLED")
@@ -143,10 +147,12 @@ class Api:
 
     def retrying(self, call, request, tenant, deadline_s=SUBMIT_RETRY_S):
         """`call` until it answers; UNAVAILABLE (server down or killed mid-call) is retried with the same request.
-        Returns (reply, retries) or raises the last non-retryable error."""
+        Returns (reply, retries) or raises the last non-retryable error; self.last_try is when the answered
+        call was sent."""
         give_up, retries = time.time() + deadline_s, 0
         while True:
             try:
+                self.last_try = time.time()
                 return call(request, timeout=10, metadata=[("authorization", f"Bearer {TOKENS[tenant]}")]), retries
             except self.grpc.RpcError as error:
                 retryable = error.code() in (self.grpc.StatusCode.UNAVAILABLE, self.grpc.StatusCode.DEADLINE_EXCEEDED)
@@ -210,6 +216,23 @@ def main():
         attempted = set()  # (tenant, request_id) of every request sent, answered or not
         kinds = {}        # job id -> kind
         retries_total = [0]
+        deduplicated = [0]  # retries answered with a job the store held before the retry was sent
+
+        def submit_one(api, tenant, request_id, kind, request, who):
+            with lock:
+                attempted.add((tenant, request_id))
+            try:
+                reply, retries = api.retrying(api.submit, request, tenant)
+            except grpc.RpcError as error:
+                check(False, f"{who} request {request_id}: {error.code()} {error.details()}")
+                return
+            with lock:
+                retries_total[0] += retries
+                if retries and reply.job.created_ms < api.last_try * 1000:
+                    deduplicated[0] += 1
+                check((tenant, request_id) not in accepted, f"request {request_id} accepted twice")
+                accepted[(tenant, request_id)] = reply.job.id
+                kinds[reply.job.id] = kind
 
         def client(index):
             rng = random.Random(options.seed * 100 + index)
@@ -218,34 +241,41 @@ def main():
             for n in range(JOBS_PER_CLIENT):
                 request_id = f"c{index}-r{n}-{rng.getrandbits(32):08x}"
                 kind, request = job_request(pb, rng, options.data_dir, request_id)
-                with lock:
-                    attempted.add((tenant, request_id))
-                try:
-                    reply, retries = api.retrying(api.submit, request, tenant)
-                except grpc.RpcError as error:
-                    check(False, f"client {index} request {request_id}: {error.code()} {error.details()}")
-                    continue
-                with lock:
-                    retries_total[0] += retries
-                    check((tenant, request_id) not in accepted, f"request {request_id} accepted twice")
-                    accepted[(tenant, request_id)] = reply.job.id
-                    kinds[reply.job.id] = kind
+                submit_one(api, tenant, request_id, kind, request, f"client {index}")
                 time.sleep(rng.uniform(0.2, 2.5))
             api.channel.close()
+
+        def burst_submit(api, tenant, request_id):
+            # Many submissions in flight when the kill lands: some are stored but never answered, and the retry
+            # with the same request_id must return that job, not a second one.
+            request = pb.SubmitJobRequest(request_id=request_id, spec=pb.JobSpec(simulate=pb.SimulateJob(
+                rest_mesh=pb.MeshFile(data=icosphere_obj(1, 10.0), format=pb.MESH_FORMAT_OBJ),
+                material=pb.MaterialRef(name="latex"), thickness_mm=0.5, volume_ratio=2.0)))
+            submit_one(api, tenant, request_id, "simulate", request, "burst")
 
         threads = [threading.Thread(target=client, args=(i,)) for i in range(CLIENTS)]
         for thread in threads:
             thread.start()
+        burst_api = Api(grpc, pb, server.address)
         killer_rng = random.Random(options.seed)
-        for _ in range(KILLS):
+        for k in range(KILLS):
             time.sleep(killer_rng.uniform(0.5, 3.0))
+            if k % BURST_EVERY == BURST_EVERY - 1:
+                burst = [threading.Thread(target=burst_submit, args=(burst_api, TENANTS[i % len(TENANTS)],
+                                                                     f"burst{k}-{i}")) for i in range(BURST_SIZE)]
+                for thread in burst:
+                    thread.start()
+                threads += burst
+                time.sleep(killer_rng.uniform(0.005, 0.05))
             server.kill()
             server.start()
         killed_at = time.time()
         for thread in threads:
             thread.join()
+        burst_api.channel.close()
         print(f"{KILLS} kills in {killed_at - began:.1f} s; {len(accepted)} of {len(attempted)} requests accepted "
-              f"({retries_total[0]} retried calls); clients done at {time.time() - began:.1f} s", flush=True)
+              f"({retries_total[0]} retried calls, {deduplicated[0]} answered by request_id with the job stored before the "
+              f"kill); clients done at {time.time() - began:.1f} s", flush=True)
 
         # Every job must end: nothing QUEUED or RUNNING, bounded.
         api = Api(grpc, pb, server.address)
@@ -264,8 +294,7 @@ def main():
         owner = {j.id: t for t, jobs in listed.items() for j in jobs}
         all_listed = [j for jobs in listed.values() for j in jobs]
         check(len(owner) == len(all_listed), "a job id is listed twice")
-        check(len(accepted) == CLIENTS * JOBS_PER_CLIENT,
-              f"{CLIENTS * JOBS_PER_CLIENT - len(accepted)} request(s) never accepted")
+        check(len(accepted) == EXPECTED_JOBS, f"{EXPECTED_JOBS - len(accepted)} request(s) never accepted")
         job_ids = list(accepted.values())
         check(len(set(job_ids)) == len(job_ids), "two requests were given the same job")
         for (tenant, request_id), job_id in accepted.items():
@@ -285,6 +314,9 @@ def main():
                           if pb.JobState.Name(j.state) == "JOB_STATE_FAILED" and "crashed the server" not in j.error]
         print(f"end states: {sorted(counts.items())}; {rerun} job(s) re-run after a kill, {len(crashed)} failed "
               f"by --max-attempts", flush=True)
+        # The kills must have hit work in flight, else this run proved nothing.
+        check(rerun > 0, "no kill landed while a job was running")
+        check(retries_total[0] > 0, "no kill landed during a submission")
         for failed in other_failures[:10]:
             print(f"  failed: {failed}", flush=True)
 
