@@ -274,8 +274,8 @@ def main():
             thread.join()
         burst_api.channel.close()
         print(f"{KILLS} kills in {killed_at - began:.1f} s; {len(accepted)} of {len(attempted)} requests accepted "
-              f"({retries_total[0]} retried calls, {deduplicated[0]} answered by request_id with the job stored before the "
-              f"kill); clients done at {time.time() - began:.1f} s", flush=True)
+              f"({retries_total[0]} retried calls, {deduplicated[0]} answered by request_id with the job stored "
+              f"before the kill); clients done at {time.time() - began:.1f} s", flush=True)
 
         # Every job must end: nothing QUEUED or RUNNING, bounded.
         api = Api(grpc, pb, server.address)
