@@ -62,13 +62,15 @@ class SealedMemoryIOSystem : public Assimp::IOSystem {
       // MemoryIOStream does not take ownership of the buffer: m_bytes outlives the import.
       return new Assimp::MemoryIOStream(reinterpret_cast<const std::uint8_t*>(m_bytes.data()), m_bytes.size());
     }
-    m_refused.emplace_back(file == nullptr ? "" : file);
+    // assimp may ask for one name several times: the message names each once.
+    const std::string name = file == nullptr ? "" : file;
+    if (std::find(m_refused.begin(), m_refused.end(), name) == m_refused.end()) m_refused.push_back(name);
     return nullptr;
   }
   void Close(Assimp::IOStream* stream) override { delete stream; }
   bool ComparePaths(const char* one, const char* second) const override { return std::strcmp(one, second) == 0; }
 
-  /// Names assimp asked for other than the uploaded file, in order.
+  /// Distinct names assimp asked for other than the uploaded file, in order.
   const std::vector<std::string>& refused() const { return m_refused; }
 
  private:
@@ -148,7 +150,7 @@ std::string check_ply_header(std::string_view bytes, const MeshReadLimits& limit
   if (header_end == std::string_view::npos) return {};  // assimp reports the missing header
   const std::string_view header = bytes.substr(0, header_end);
   const std::size_t body = bytes.size() - header_end;
-  for (const auto [name, limit] : {std::pair{std::string_view("vertex"), limits.max_vertices},
+  for (const auto& [name, limit] : {std::pair{std::string_view("vertex"), limits.max_vertices},
                                    std::pair{std::string_view("face"), limits.max_faces}}) {
     const std::string prefix = "element " + std::string(name) + " ";
     const std::size_t at = header.find(prefix);
