@@ -337,6 +337,16 @@ TEST(HostileInputs, CatalogueGetsItsStatusesAndTheServerStaysServingAndSmall) {
     return stl;
   }(), v1::MESH_FORMAT_STL, StatusCode::INVALID_ARGUMENT, "rest_mesh");
 
+  // Inputs on which assimp 5.2 loops for ever or leaks (found by tests/fuzz): refused before assimp sees them.
+  mesh_case("PLY header with a nameless element (assimp loops)", "ply\nformat ascii 1.0\nelement 1\n1 0.125 0.625\nend_header\n",
+            v1::MESH_FORMAT_PLY, StatusCode::INVALID_ARGUMENT, "bad PLY header: line 3");
+  mesh_case("ASCII PLY with a word among its numbers",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+            "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 x0\n3 0 1 2\n",
+            v1::MESH_FORMAT_PLY, StatusCode::INVALID_ARGUMENT, "'x0' is not a number");
+  mesh_case("glTF with bad base64", gltf_with_uri("data:application/octet-stream;base64,AA*A"), v1::MESH_FORMAT_GLTF,
+            StatusCode::INVALID_ARGUMENT, "bad base64");
+
   // Non-finite coordinates: refused before the weld, in time linear in the file.
   for (const std::uint32_t triangles : {5000u, 20000u, 80000u}) {
     mesh_case("NaN STL of " + std::to_string(triangles) + " triangles", nan_stl(triangles), v1::MESH_FORMAT_STL,

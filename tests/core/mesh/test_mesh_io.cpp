@@ -627,6 +627,31 @@ TEST(MeshIoHostile, HeaderBombsAreRefusedBeforeAllocation) {
   EXPECT_TRUE(is_over_limit_error(limited.error()));
 }
 
+TEST(MeshIoHostile, InputsThatAssimpMishandlesAreRefusedBeforeIt) {
+  // Found by tests/fuzz: assimp 5.2 loops for ever on this PLY header (an element without a name)...
+  const auto nameless = read_mesh_from_memory("ply\nformat ascii 1.0\nelement 1\n1 0.125 0.625\nend_header\n", "ply");
+  ASSERT_FALSE(nameless.ok());
+  expect_contains(nameless.error(), {"bad PLY header: line 3", "element NAME COUNT"});
+  // ...and leaks its arrays when an ASCII PLY or STL number, or a glTF's base64, does not parse.
+  const std::string ply_header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const auto ply = read_mesh_from_memory(ply_header + "0 0 0\n1 0 0\n0 1 x0\n3 0 1 2\n", "ply");
+  ASSERT_FALSE(ply.ok());
+  expect_contains(ply.error(), {"bad PLY data: line 12", "'x0' is not a number"});
+  ASSERT_TRUE(read_mesh_from_memory(ply_header + "0 0 0\n1 0 0\n0 1 -1e-3\n3 0 1 2\n", "ply").ok());
+  const auto stl = read_mesh_from_memory(
+      "solid s\nfacet normal 0 0 0\nouter loop\nvertex 8.5dae 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
+      "endsolid s\n", "stl");
+  ASSERT_FALSE(stl.ok());
+  expect_contains(stl.error(), {"bad ASCII STL: line 4", "'8.5dae' is not a number"});
+  const auto gltf = read_mesh_from_memory(
+      R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":3,"uri":"data:application/octet-stream;base64,AA\u00e9A"}]})",
+      "gltf");
+  ASSERT_FALSE(gltf.ok());
+  expect_contains(gltf.error(), {"bad base64 in a data: URI"});
+}
+
 TEST(MeshIoHostile, LimitsHoldForEveryFormat) {
   const TriMesh sphere = make_icosphere(1.0, 2);  // 162 vertices, 320 faces
   const MeshReadLimits few_vertices{100, 0};
