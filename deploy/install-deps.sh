@@ -8,6 +8,8 @@ PACKAGES=(
   cmake ninja-build pkg-config g++ git
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
+  # fuzzing (tests/fuzz): clang with libFuzzer and the ASan/UBSan runtimes
+  clang libclang-rt-14-dev
   # numerics: Eigen, CHOLMOD (SuiteSparse) with OpenBLAS behind it, nanoflann (kd-tree), CGAL (remeshing, AABB)
   libeigen3-dev libsuitesparse-dev libopenblas0-pthread libnanoflann-dev libcgal-dev
   # mesh files

@@ -2,7 +2,7 @@
 # Builds the libFuzzer targets (build-fuzz, clang, if needed) and runs each for DURATION_S seconds on its
 # seed corpus. Any crash, leak, sanitizer report or input taking over 1 s fails the run: the script exits
 # non-zero and names the targets, whose reproducers are left in build-fuzz/findings/<target>/.
-# Usage: tests/fuzz/run_fuzzers.sh DURATION_S [TARGET...]   (BUILD_DIR overrides build-fuzz)
+# Usage: tests/fuzz/run_fuzzers.sh DURATION_S [TARGET...]   (FUZZ_BUILD_DIR overrides build-fuzz)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 
@@ -16,7 +16,7 @@ targets=("$@")
 if ((${#targets[@]} == 0)); then
   targets=(fuzz_mesh_obj fuzz_mesh_off fuzz_mesh_stl fuzz_mesh_ply fuzz_mesh_gltf fuzz_mesh_glb fuzz_measurements_csv)
 fi
-build=${BUILD_DIR:-build-fuzz}
+build=${FUZZ_BUILD_DIR:-build-fuzz}
 
 if ! command -v clang++ >/dev/null 2>&1; then
   echo "run_fuzzers: clang++ not found (deploy/install-deps.sh installs clang and libclang-rt-14-dev)" >&2
