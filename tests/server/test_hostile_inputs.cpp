@@ -544,6 +544,7 @@ TEST(HostileInputs, CatalogueGetsItsStatusesAndTheServerStaysServingAndSmall) {
     EXPECT_LT(status.error_message().size(), 1000u) << c.name;
     // Nothing hostile is slow: the 80k-triangle NaN STL took 81 s while the weld was quadratic.
     EXPECT_LT(seconds, 10.0) << c.name;
+    if (seconds > 0.05 || c.name.rfind("NaN STL", 0) == 0) std::printf("%s: %.3f s\n", c.name.c_str(), seconds);
   }
 
   // Every hostile-but-valid job ends by itself (time limit 3 s each, one worker).
