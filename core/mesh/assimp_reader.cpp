@@ -2,10 +2,12 @@
 
 #include <Eigen/Geometry>
 
+#include <assimp/BaseImporter.h>
 #include <assimp/IOStream.hpp>
 #include <assimp/IOSystem.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/MemoryIOWrapper.h>
+#include <assimp/importerdesc.h>
 #include <assimp/scene.h>
 
 #include <algorithm>
@@ -17,6 +19,7 @@
 #include <cstdint>
 #include <cstring>
 #include <memory>
+#include <sstream>
 #include <string_view>
 #include <tuple>
 #include <unordered_map>
@@ -484,9 +487,9 @@ class SceneMerger {
 // distinct vertices of small meshes) and not across meshes; SceneMerger welds exact positions instead.
 constexpr unsigned ASSIMP_FLAGS = 0;
 
-Result<TriMesh> scene_to_mesh(const aiScene* scene, const Assimp::Importer& importer, const MeshReadLimits& limits) {
+Result<TriMesh> scene_to_mesh(const aiScene* scene, const std::string& error, const MeshReadLimits& limits) {
   if (scene == nullptr) {
-    std::string reason = one_line(importer.GetErrorString());
+    std::string reason = one_line(error);
     // Reading from memory, assimp names the data after a made-up file; say "the data" instead.
     for (std::size_t at = reason.find(MEMORY_FILE_NAME); at != std::string::npos; at = reason.find(MEMORY_FILE_NAME)) {
       std::size_t end = at + MEMORY_FILE_NAME.size();
@@ -504,6 +507,22 @@ Result<TriMesh> scene_to_mesh(const aiScene* scene, const Assimp::Importer& impo
   return SceneMerger(*scene, limits).merge();
 }
 
+/// The importer assimp registers for `format` (an extension); for glTF the 2.0 one, as the upload promises.
+Assimp::BaseImporter* importer_for(const Assimp::Importer& importer, const std::string& format) {
+  for (std::size_t i = 0; i < importer.GetImporterCount(); ++i) {
+    const aiImporterDesc* info = importer.GetImporterInfo(i);
+    if (info == nullptr || info->mFileExtensions == nullptr) continue;
+    std::istringstream extensions(info->mFileExtensions);
+    for (std::string extension; extensions >> extension;) {
+      const bool gltf = format == "gltf" || format == "glb";
+      if (extension == format && (!gltf || std::string_view(info->mName).find("glTF2") != std::string_view::npos)) {
+        return importer.GetImporter(i);
+      }
+    }
+  }
+  return nullptr;
+}
+
 std::string refused_files_message(const std::vector<std::string>& refused) {
   std::string message = "refers to a file outside the upload (" + quoted(refused.front());
   for (std::size_t i = 1; i < std::min(refused.size(), NAMED_REFUSALS); ++i) message += ", " + quoted(refused[i]);
@@ -519,16 +538,20 @@ Result<TriMesh> read_with_assimp(const std::string& bytes, const std::string& fo
   Assimp::Importer importer;
   auto* io = new SealedMemoryIOSystem(bytes, name);
   importer.SetIOHandler(io);  // the importer owns and deletes it
-  const aiScene* scene = importer.ReadFile(name, ASSIMP_FLAGS);
+  // The declared format's importer only: Importer::ReadFile falls back to guessing the format from the bytes,
+  // which hands an upload to any of assimp's ~40 importers (fuzzing reached a heap overflow that way).
+  Assimp::BaseImporter* reader = importer_for(importer, format);
+  if (reader == nullptr) return fail("this assimp has no " + format + " importer");
+  const std::unique_ptr<aiScene> scene(reader->ReadFile(&importer, name, io));
   // Refused names come first: even when assimp carried on without them, the upload was not self-contained.
   if (!io->refused().empty()) return fail(refused_files_message(io->refused()));
-  return scene_to_mesh(scene, importer, limits);
+  return scene_to_mesh(scene.get(), reader->GetErrorText(), limits);
 }
 
 Result<TriMesh> read_file_with_assimp(const std::string& path, const MeshReadLimits& limits) {
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(path, ASSIMP_FLAGS);
-  return scene_to_mesh(scene, importer, limits);
+  return scene_to_mesh(scene, importer.GetErrorString(), limits);
 }
 
 }  // namespace balloon

@@ -652,6 +652,17 @@ TEST(MeshIoHostile, InputsThatAssimpMishandlesAreRefusedBeforeIt) {
   expect_contains(gltf.error(), {"bad base64 in a data: URI"});
 }
 
+TEST(MeshIoHostile, OnlyTheDeclaredFormatsImporterReadsTheBytes) {
+  // assimp's ReadFile guesses another format when the declared one's importer declines: an OBJ sent as
+  // STL or glTF was read by the OBJ importer. Now the declared importer alone reads it, and refuses it.
+  const std::string obj = write_mesh_to_memory(make_icosphere(1.0, 0), "obj");
+  for (const char* format : {"stl", "gltf", "glb"}) {
+    SCOPED_TRACE(format);
+    const auto result = read_mesh_from_memory(obj, format);
+    EXPECT_FALSE(result.ok());
+  }
+}
+
 TEST(MeshIoHostile, LimitsHoldForEveryFormat) {
   const TriMesh sphere = make_icosphere(1.0, 2);  // 162 vertices, 320 faces
   const MeshReadLimits few_vertices{100, 0};
