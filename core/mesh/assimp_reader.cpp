@@ -294,9 +294,14 @@ std::string check_stl_size(std::string_view bytes, const MeshReadLimits& limits)
   return over_limit_message(static_cast<std::int64_t>(faces), limits.max_faces, "faces");
 }
 
-/// "" or why an ASCII STL is malformed: keywords in their places and three numbers after each "normal"
-/// and "vertex". assimp 5.2 leaks its arrays when a number does not parse (tests/fuzz/README.md).
+/// "" or why an ASCII STL is malformed: each facet is "facet normal N N N", "outer loop", three "vertex X Y Z",
+/// "endloop", "endfacet", with numbers where numbers go. assimp 5.2 leaks its arrays when a number does not
+/// parse or a facet has no vertices (tests/fuzz/README.md).
 std::string check_ascii_stl(std::string_view bytes) {
+  // What the next line must be: facet (or solid/endsolid), outer loop, vertex x3, endloop, endfacet.
+  enum class Next { Facet, OuterLoop, Vertex, EndLoop, EndFacet };
+  Next next = Next::Facet;
+  int vertices = 0;
   std::size_t at = 0;
   int line_number = 0;
   while (at < bytes.size()) {
@@ -304,28 +309,39 @@ std::string check_ascii_stl(std::string_view bytes) {
     const std::vector<std::string_view> words = words_of(bytes.substr(at, newline - at));
     at = newline + 1;
     ++line_number;
-    if (words.empty() || words[0] == "solid" || words[0] == "endsolid") continue;  // a solid's name is free text
+    if (words.empty()) continue;
+    const std::string where = "bad ASCII STL: line " + std::to_string(line_number) + ": ";
     std::size_t first_number = 0;
-    if (words[0] == "facet" && words.size() >= 2 && words[1] == "normal") {
+    if (next == Next::Facet && (words[0] == "solid" || words[0] == "endsolid")) continue;  // the name is free text
+    if (next == Next::Facet && words[0] == "facet" && words.size() >= 2 && words[1] == "normal") {
       first_number = 2;
-    } else if (words[0] == "vertex") {
+      next = Next::OuterLoop;
+    } else if (next == Next::OuterLoop && words.size() == 2 && words[0] == "outer" && words[1] == "loop") {
+      next = Next::Vertex;
+      vertices = 0;
+      continue;
+    } else if (next == Next::Vertex && words[0] == "vertex") {
       first_number = 1;
-    } else if ((words[0] == "outer" && words.size() == 2 && words[1] == "loop") ||
-               (words.size() == 1 && (words[0] == "endloop" || words[0] == "endfacet"))) {
+      if (++vertices == 3) next = Next::EndLoop;
+    } else if (next == Next::EndLoop && words.size() == 1 && words[0] == "endloop") {
+      next = Next::EndFacet;
+      continue;
+    } else if (next == Next::EndFacet && words.size() == 1 && words[0] == "endfacet") {
+      next = Next::Facet;
       continue;
     } else {
-      return "bad ASCII STL: line " + std::to_string(line_number) + ": unexpected " + quoted(words[0].substr(0, 40));
+      static constexpr const char* EXPECTED[] = {"'facet normal' or 'endsolid'", "'outer loop'", "'vertex'", "'endloop'",
+                                                 "'endfacet'"};
+      return where + "expected " + EXPECTED[static_cast<int>(next)] + ", found " + quoted(words[0].substr(0, 40));
     }
     if (words.size() != first_number + 3) {
-      return "bad ASCII STL: line " + std::to_string(line_number) + ": expected 3 numbers after '" +
-             std::string(words[first_number - 1]) + "'";
+      return where + "expected 3 numbers after '" + std::string(words[first_number - 1]) + "'";
     }
     for (std::size_t k = first_number; k < words.size(); ++k) {
-      if (!is_number_token(words[k])) {
-        return "bad ASCII STL: line " + std::to_string(line_number) + ": " + quoted(words[k].substr(0, 40)) + " is not a number";
-      }
+      if (!is_number_token(words[k])) return where + quoted(words[k].substr(0, 40)) + " is not a number";
     }
   }
+  if (next != Next::Facet) return "bad ASCII STL: the last facet is not complete";
   return {};
 }
 

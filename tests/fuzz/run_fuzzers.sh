@@ -38,6 +38,7 @@ failed=()
 for target in "${targets[@]}"; do
   corpus="$build/corpus/$target"
   findings="$build/findings/$target"
+  rm -rf "$findings"  # only this run's findings
   mkdir -p "$corpus" "$findings"
   log="$build/findings/$target.log"
   echo "run_fuzzers: $target for ${duration} s"

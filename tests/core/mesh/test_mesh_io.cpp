@@ -645,6 +645,9 @@ TEST(MeshIoHostile, InputsThatAssimpMishandlesAreRefusedBeforeIt) {
       "endsolid s\n", "stl");
   ASSERT_FALSE(stl.ok());
   expect_contains(stl.error(), {"bad ASCII STL: line 4", "'8.5dae' is not a number"});
+  const auto empty_facet = read_mesh_from_memory("solid s\nfacet normal 0 0 0\nouter loop\nendfacet\nendsolid s\n", "stl");
+  ASSERT_FALSE(empty_facet.ok());
+  expect_contains(empty_facet.error(), {"bad ASCII STL: line 4", "expected 'vertex', found 'endfacet'"});
   const auto gltf = read_mesh_from_memory(
       R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":3,"uri":"data:application/octet-stream;base64,AA\u00e9A"}]})",
       "gltf");
