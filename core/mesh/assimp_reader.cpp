@@ -127,11 +127,45 @@ std::vector<std::string_view> gltf_uris(std::string_view json) {
   return uris;
 }
 
-/// "" or why a glTF/GLB refers to data outside itself.
+/// JSON nesting (objects and arrays) deeper than this is refused: assimp's JSON parser (rapidjson) recurses
+/// once per level, and 200,000 levels in a 400 kB upload overflowed the stack and killed the server.
+constexpr int MAX_JSON_DEPTH = 64;
+
+/// More JSON objects than this are refused: assimp's glTF importer also recurses once per level of the node
+/// tree, which a flat array of 20,000 nodes, each the child of the one before, overflowed (measured under
+/// ASan; a balloon upload has a few dozen objects).
+constexpr int MAX_JSON_OBJECTS = 4096;
+
+/// "" or why a JSON text nests deeper than MAX_JSON_DEPTH or holds more than MAX_JSON_OBJECTS objects
+/// (strings skipped; the syntax is assimp's to check).
+std::string check_json_depth(std::string_view json) {
+  int depth = 0, objects = 0;
+  for (std::size_t i = 0; i < json.size(); ++i) {
+    const char c = json[i];
+    if (c == '"') {
+      for (++i; i < json.size() && json[i] != '"'; ++i) {
+        if (json[i] == '\\') ++i;
+      }
+    } else if (c == '{' || c == '[') {
+      if (c == '{' && ++objects > MAX_JSON_OBJECTS) {
+        return "the JSON has more than " + std::to_string(MAX_JSON_OBJECTS) + " objects (at byte " + std::to_string(i) + ")";
+      }
+      if (++depth > MAX_JSON_DEPTH) {
+        return "the JSON is nested deeper than " + std::to_string(MAX_JSON_DEPTH) + " levels (at byte " + std::to_string(i) + ")";
+      }
+    } else if (c == '}' || c == ']') {
+      --depth;
+    }
+  }
+  return {};
+}
+
+/// "" or why a glTF/GLB nests too deep or refers to data outside itself.
 std::string check_gltf_uris(std::string_view bytes, const std::string& format) {
   std::string error;
   const std::string_view json = gltf_json_text(bytes, format, error);
   if (!error.empty()) return error;
+  if (std::string problem = check_json_depth(json); !problem.empty()) return problem;
   std::vector<std::string_view> external;
   for (const std::string_view uri : gltf_uris(json)) {
     if (uri.substr(0, 5) != "data:") {

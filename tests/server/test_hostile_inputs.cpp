@@ -316,6 +316,15 @@ TEST(HostileInputs, CatalogueGetsItsStatusesAndTheServerStaysServingAndSmall) {
             StatusCode::INVALID_ARGUMENT, "outside the upload ('/etc/passwd'); only");
   mesh_case("GLB with an external buffer", glb_with_external_buffer("/etc/passwd"), v1::MESH_FORMAT_GLB,
             StatusCode::INVALID_ARGUMENT, "uri '/etc/passwd'");
+  mesh_case("glTF nested 200000 deep (assimp's JSON parser recursed off the stack)",
+            R"({"asset":{"version":"2.0"},"extras":)" + std::string(200000, '[') + std::string(200000, ']') + "}",
+            v1::MESH_FORMAT_GLTF, StatusCode::INVALID_ARGUMENT, "nested deeper than");
+  {
+    std::string chain = R"({"asset":{"version":"2.0"},"nodes":[)";
+    for (int i = 0; i < 100000; ++i) chain += R"({"children":[)" + std::to_string(i + 1) + "]},";
+    mesh_case("glTF node tree 100000 deep (assimp recursed off the stack)", chain + "{}]}", v1::MESH_FORMAT_GLTF,
+              StatusCode::INVALID_ARGUMENT, "more than 4096 objects");
+  }
   mesh_case("glTF that is not JSON", "{\"asset\":", v1::MESH_FORMAT_GLTF, StatusCode::INVALID_ARGUMENT, "rest_mesh");
 
   // Header bombs: counts that the bytes cannot hold are refused before any allocation.

@@ -653,6 +653,18 @@ TEST(MeshIoHostile, InputsThatAssimpMishandlesAreRefusedBeforeIt) {
       "gltf");
   ASSERT_FALSE(gltf.ok());
   expect_contains(gltf.error(), {"bad base64 in a data: URI"});
+  // Found by the catalogue: rapidjson recursed once per level, and 200,000 levels overflowed the stack.
+  const auto deep = read_mesh_from_memory(
+      R"({"asset":{"version":"2.0"},"extras":)" + std::string(200000, '[') + std::string(200000, ']') + "}", "gltf");
+  ASSERT_FALSE(deep.ok());
+  expect_contains(deep.error(), {"nested deeper than 64 levels"});
+  // A node tree 20,000 deep in a flat array overflowed it too (each node the child of the one before).
+  std::string chain = R"({"asset":{"version":"2.0"},"nodes":[)";
+  for (int i = 0; i < 20000; ++i) chain += R"({"children":[)" + std::to_string(i + 1) + "]},";
+  chain += "{}]}";
+  const auto deep_nodes = read_mesh_from_memory(chain, "gltf");
+  ASSERT_FALSE(deep_nodes.ok());
+  expect_contains(deep_nodes.error(), {"more than 4096 objects"});
 }
 
 TEST(MeshIoHostile, OnlyTheDeclaredFormatsImporterReadsTheBytes) {
