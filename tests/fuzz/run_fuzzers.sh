@@ -34,6 +34,16 @@ cmake --build "$build" -j"$(nproc)" --target balloon_fuzz
 rm -rf "$build/seeds"
 "$build/tests/fuzz/make_fuzz_seeds" tests/data "$build/seeds"
 
+# True if the run's only finding is a timeout whose input runs within the 1 s limit twice on replay.
+replay_in_time() {
+  local target=$1 findings=$2 unit
+  unit=$(ls "$findings"/timeout-* 2>/dev/null | head -1)
+  [[ -n $unit && $(ls "$findings" | wc -l) -eq 1 ]] || return 1
+  for _ in 1 2; do
+    timeout -k 5 30 "$build/tests/fuzz/$target" -timeout=1 -runs=1 "$unit" >/dev/null 2>&1 || return 1
+  done
+}
+
 failed=()
 for target in "${targets[@]}"; do
   corpus="$build/corpus/$target"
@@ -49,6 +59,9 @@ for target in "${targets[@]}"; do
       -error_exitcode=77 -timeout_exitcode=78 -artifact_prefix="$findings/" -print_final_stats=1 \
       "$corpus" "$build/seeds/$target" >"$log" 2>&1; then
     grep -E '^stat::number_of_executed_units|^#[0-9]+.*DONE' "$log" | tail -2 | sed "s/^/  /"
+  elif replay_in_time "$target" "$findings"; then
+    # A shared machine can stall any input for a second; the input itself replayed in time.
+    echo "run_fuzzers: $target: a timeout that did not reproduce (machine load), not counted"
   else
     echo "run_fuzzers: $target FAILED (log $log, reproducer in $findings/):" >&2
     grep -E 'ERROR|SUMMARY|Test unit written|runtime error' "$log" | head -8 | sed "s/^/  /" >&2
