@@ -6,8 +6,8 @@ set -euo pipefail
 PACKAGES=(
   # toolchain
   cmake ninja-build pkg-config g++ git
-  # tests and benchmarks
-  libgtest-dev libgmock-dev libbenchmark-dev
+  # tests and benchmarks (openssl: the HTTPS gateway test makes a self-signed certificate)
+  libgtest-dev libgmock-dev libbenchmark-dev openssl
   # fuzzing (tests/fuzz): clang with libFuzzer and the ASan/UBSan runtimes
   clang libclang-rt-14-dev
   # numerics: Eigen, CHOLMOD (SuiteSparse) with OpenBLAS behind it, nanoflann (kd-tree), CGAL (remeshing, AABB)
@@ -16,6 +16,8 @@ PACKAGES=(
   libassimp-dev
   # service: gRPC, protobuf, SQLite, HTTP gateway
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler libsqlite3-dev libcpp-httplib-dev
+  # HTTPS for the gateway (--http-tls-cert): Debian's cpp-httplib is built with CPPHTTPLIB_OPENSSL_SUPPORT
+  libssl-dev
   # cross-language client test
   python3-grpcio python3-protobuf
   # several shards behind a load balancer (tests/deploy): HAProxy (the test runs its own, unprivileged; the

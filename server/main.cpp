@@ -91,6 +91,10 @@ int main(int argc, char** argv) {
     options.address = command->http_address;
     options.web_root = command->web_root;
     options.max_body_bytes = static_cast<std::size_t>(config.max_message_bytes);
+    options.allowed_origins = command->http_allowed_origins;
+    options.tls_cert_file = command->http_tls_cert_file;
+    options.tls_key_file = command->http_tls_key_file;
+    options.max_event_streams = command->http_max_event_streams;
     options.log = log_line;
     auto started = balloon::http::HttpGateway::start(options, (*server)->in_process_channel());
     if (!started) {
@@ -108,7 +112,8 @@ int main(int argc, char** argv) {
     std::string http_where = command->http_address;
     http_where.resize(http_where.rfind(':') + 1);
     http_where.append(std::to_string(gateway->port()));
-    std::printf("balloon-server http on %s (web root %s)\n", http_where.c_str(), command->web_root.c_str());
+    std::printf("balloon-server http on %s (%sweb root %s)\n", http_where.c_str(),
+                command->http_tls_cert_file.empty() ? "" : "https, ", command->web_root.c_str());
   }
   // One flush for both lines: readers that stop after the first line still find the pipe's whole write.
   std::fflush(stdout);

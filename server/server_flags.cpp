@@ -8,6 +8,8 @@
 #include <thread>
 
 #include "service/shard_name.hpp"
+#include "http/origin_policy.hpp"
+#include "net/network_address.hpp"
 
 namespace balloon::server {
 namespace {
@@ -21,6 +23,9 @@ const std::map<std::string, bool>& known_flags() {
       {"progress-mesh-every", true}, {"quiet", false}, {"config", true}, {"help", false},
       {"http", true},         {"web-root", true},
       {"shard-name", true},   {"drain-timeout", true},
+      {"http", true},         {"web-root", true},       {"http-allowed-origin", true},
+      {"http-tls-cert", true}, {"http-tls-key", true},   {"http-max-event-streams", true},
+      {"insecure-plaintext-tokens", false},
   };
   return flags;
 }
@@ -98,7 +103,8 @@ std::string server_usage() {
          "  --max-mesh-vertices N    largest mesh accepted, in vertices [200000]\n"
          "  --job-time-limit S       wall-time limit per job in seconds [3600]\n"
          "  --progress-mesh-every K  stream the intermediate mesh every K shape updates [1]\n"
-         "  --token-file F           require 'authorization: Bearer <token>'; lines 'TENANT TOKEN' [none]\n"
+         "  --token-file F           require 'authorization: Bearer <token>'; lines 'TENANT TOKEN' or\n"
+         "                           'TENANT TOKEN raise-priority' (may submit priority above 0) [none]\n"
          "  --tls-cert F, --tls-key F  serve TLS with this PEM certificate chain and key [plaintext]\n"
          "  --http HOST:PORT         also serve the JSON API (/api/v1) and the web page over HTTP on this\n"
          "                           address, e.g. 127.0.0.1:8080; port 0 picks one [off]\n"
@@ -107,7 +113,15 @@ std::string server_usage() {
          "                           shard's job answer FAILED_PRECONDITION; a-z, 0-9, '-', <= 32 chars [none]\n"
          "  --drain-timeout S        on SIGTERM: NOT_SERVING at once, new jobs refused (UNAVAILABLE), running\n"
          "                           jobs re-queued; the process ends within S seconds [30]\n"
+         "  --http-tls-cert F, --http-tls-key F  serve the HTTP side as HTTPS with this PEM certificate chain\n"
+         "                           and key [plaintext]\n"
+         "  --http-allowed-origin URL  also accept requests from the page at URL (SCHEME://HOST[:PORT], e.g.\n"
+         "                           https://balloon.example) and with its host in the Host header; repeatable.\n"
+         "                           Otherwise only loopback names with the HTTP port are served [none]\n"
+         "  --http-max-event-streams N  open job event streams at most; more get 503 [64]\n"
          "  --insecure-listen-any    allow non-loopback --listen/--http addresses without a token file [off]\n"
+         "  --insecure-plaintext-tokens  allow tokens over plaintext gRPC/HTTP on non-loopback addresses\n"
+         "                           (e.g. behind a proxy that terminates TLS) [off]\n"
          "  --quiet                  no per-job log lines on stderr [off]\n"
          "  --config FILE            read 'name = value' settings first (names as the flags) [none]\n"
          "  --help                   this text\n\n"
@@ -165,7 +179,17 @@ Result<ServerCommand> parse_server_flags(const std::vector<std::string>& args) {
       Result<double> s = to_number(name, value);
       if (!s || *s > 3600.0) return fail("--drain-timeout: '" + value + "' is not a number of seconds in (0, 3600]");
       command.drain_timeout_s = *s;
-    } else if (name == "workers") {
+    }
+    else if (name == "http-allowed-origin") command.http_allowed_origins.push_back(value);
+    else if (name == "http-tls-cert") command.http_tls_cert_file = value;
+    else if (name == "http-tls-key") command.http_tls_key_file = value;
+    else if (name == "insecure-plaintext-tokens") config.insecure_plaintext_tokens = true;
+    else if (name == "http-max-event-streams") {
+      Result<long long> n = to_integer(name, value, 1, 1000);
+      if (!n) return fail(n.error());
+      command.http_max_event_streams = static_cast<int>(*n);
+    }
+    else if (name == "workers") {
       Result<long long> n = to_integer(name, value, 1, 1024);
       if (!n) return fail(n.error());
       config.service.workers = static_cast<int>(*n);
@@ -192,12 +216,29 @@ Result<ServerCommand> parse_server_flags(const std::vector<std::string>& args) {
     }
   }
   if (command.web_root.empty()) command.web_root = default_web_root();
-  // The same rule as for --listen (GrpcServer::start): a port anyone can reach needs tokens.
-  if (!command.http_address.empty() && config.token_file.empty() && !config.insecure_listen_any &&
-      !rpc::is_loopback_address(command.http_address))
+  for (const std::string& origin : command.http_allowed_origins) {
+    Result<http::WebOrigin> parsed = http::parse_origin(origin);
+    if (!parsed) return fail("--http-allowed-origin: " + parsed.error());
+  }
+  if (command.http_tls_cert_file.empty() != command.http_tls_key_file.empty())
+    return fail("HTTPS needs both --http-tls-cert and --http-tls-key");
+  if (command.http_address.empty() && (!command.http_tls_cert_file.empty() || !command.http_allowed_origins.empty()))
+    return fail("--http-tls-cert, --http-tls-key and --http-allowed-origin need --http HOST:PORT");
+  // The same rules as for --listen (GrpcServer::start): a port anyone can reach needs tokens, and tokens
+  // that cross the network need TLS.
+  // An address that does not parse is left to HttpGateway::start, which names the problem.
+  const bool http_off_loopback = !command.http_address.empty() &&
+                                 net::split_host_port(command.http_address).ok() &&
+                                 !net::is_loopback_address(command.http_address);
+  if (http_off_loopback && config.token_file.empty() && !config.insecure_listen_any)
     return fail("refusing to serve HTTP on '" + command.http_address +
                 "' without --token-file (anyone could submit jobs); use a loopback address, a token file, or "
                 "--insecure-listen-any");
+  if (http_off_loopback && !config.token_file.empty() && command.http_tls_cert_file.empty() &&
+      !config.insecure_plaintext_tokens)
+    return fail("refusing to accept tokens over plaintext HTTP on '" + command.http_address +
+                "' (anyone on the network path could read them); give --http-tls-cert and --http-tls-key, use a "
+                "loopback address, or --insecure-plaintext-tokens (e.g. behind a proxy that terminates TLS)");
   if (config.service.workers <= 0) config.service.workers = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   return command;
 }

@@ -13,6 +13,10 @@ struct ServerCommand {
   rpc::ServerConfig config;
   std::string http_address;  ///< --http HOST:PORT: also serve the JSON API and the page; empty: no HTTP
   std::string web_root;      ///< --web-root DIR: the page's files (default: the page CMake built)
+  std::vector<std::string> http_allowed_origins;  ///< --http-allowed-origin URL (repeatable), checked
+  std::string http_tls_cert_file;  ///< --http-tls-cert FILE: serve HTTPS with this PEM certificate chain
+  std::string http_tls_key_file;   ///< --http-tls-key FILE: and this PEM key
+  int http_max_event_streams = 64;  ///< --http-max-event-streams N: more get 503
   bool help = false;   ///< print server_usage() and exit
   bool quiet = false;  ///< no per-job log lines
   double drain_timeout_s = 30.0;  ///< --drain-timeout S: after SIGTERM the process ends within this (s)

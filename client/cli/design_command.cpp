@@ -67,9 +67,12 @@ constexpr const char* HELP =
     "                         if missing, files in it are replaced\n"
     "  --json                 print the report JSON on stdout instead of a summary\n"
     "  --help                 this text\n\n"
-    "Report keys: converged, method, avg_error_mm, max_error_mm, avg_error_rel, max_error_rel,\n"
+    "Report keys: converged, stop_reason (matched, optimal, stalled, time_limit, iteration_limit,\n"
+    "start_failed, cancelled; converged means matched or optimal), method, avg_error_mm, max_error_mm,\n"
+    "avg_error_rel, max_error_rel (null when there is no design),\n"
     "bbox_diag_mm, pressure_kpa, volume_ratio, iterations, time_s, vertices, active_terms,\n"
-    "baseline_avg_error_mm, baseline_max_error_mm, distance_energy, residual_norm (N), material,\n"
+    "baseline_avg_error_mm, baseline_max_error_mm (null when the start was not inflated), distance_energy,\n"
+    "residual_norm (N), material,\n"
     "thickness_mm, message, preparation, nozzle, mold, tolerance (with --tolerance-samples), convergence.\n\n"
     "Progress: a bar with iteration, current average error and ETA on a terminal; plain lines on stderr\n"
     "otherwise. Exit codes: 0 converged, 2 bad input (one line on stderr names it, before any work),\n"
@@ -166,6 +169,7 @@ double number_field(const Struct& object, const std::string& key) {
   return value != nullptr ? value->number_value() : 0.0;
 }
 
+
 /// The convergence log from the report's parallel arrays.
 std::vector<ConvergenceSample> convergence_from_report(const Struct& report) {
   std::vector<ConvergenceSample> log;
@@ -192,21 +196,30 @@ std::string format(const char* pattern, double value) {
   return buffer;
 }
 
+/// A report number formatted with `pattern`, or "n/a" when the report has none (null: never computed).
+std::string shown_number(const Struct& object, const std::string& key, const char* pattern, double scale = 1.0) {
+  const Value* value = field(object, key);
+  if (value == nullptr || !value->has_number_value()) return "n/a";
+  return format(pattern, scale * value->number_value());
+}
+
 std::string summary_from_report(const Struct& report, const std::string& out_dir) {
   const Value* converged = field(report, "converged");
   std::ostringstream out;
-  out << (converged != nullptr && converged->bool_value() ? "converged" : "NOT converged") << " after "
+  const Value* stop_reason = field(report, "stop_reason");
+  out << (converged != nullptr && converged->bool_value() ? "converged" : "NOT converged")
+      << (stop_reason != nullptr ? " (" + stop_reason->string_value() + ")" : std::string()) << " after "
       << number_field(report, "iterations") << " iterations in " << format("%.3f", number_field(report, "time_s"))
       << " s (" << (field(report, "method") ? field(report, "method")->string_value() : "") << ")\n";
   if (const Value* message = field(report, "message"); message != nullptr && !message->string_value().empty())
     out << "  " << message->string_value() << "\n";
-  out << "  error          avg " << format("%.4g", number_field(report, "avg_error_mm")) << " mm ("
-      << format("%.3g", 100.0 * number_field(report, "avg_error_rel")) << "%), max "
-      << format("%.4g", number_field(report, "max_error_mm")) << " mm ("
-      << format("%.3g", 100.0 * number_field(report, "max_error_rel")) << "%) of bbox diagonal "
+  out << "  error          avg " << shown_number(report, "avg_error_mm", "%.4g") << " mm ("
+      << shown_number(report, "avg_error_rel", "%.3g", 100.0) << "%), max "
+      << shown_number(report, "max_error_mm", "%.4g") << " mm ("
+      << shown_number(report, "max_error_rel", "%.3g", 100.0) << "%) of bbox diagonal "
       << format("%.4g", number_field(report, "bbox_diag_mm")) << " mm\n";
-  out << "  baseline       avg " << format("%.4g", number_field(report, "baseline_avg_error_mm")) << " mm, max "
-      << format("%.4g", number_field(report, "baseline_max_error_mm")) << " mm (the downscaled target inflated)\n";
+  out << "  baseline       avg " << shown_number(report, "baseline_avg_error_mm", "%.4g") << " mm, max "
+      << shown_number(report, "baseline_max_error_mm", "%.4g") << " mm (the downscaled target inflated)\n";
   out << "  inflation      " << format("%.5g", number_field(report, "pressure_kpa")) << " kPa, volume ratio "
       << format("%.4g", number_field(report, "volume_ratio")) << ", " << number_field(report, "vertices")
       << " vertices\n";

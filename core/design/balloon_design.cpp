@@ -11,6 +11,7 @@
 #include <memory>
 #include <optional>
 
+#include "design/adjoint_sensitivity.hpp"
 #include "design/distance_energy.hpp"
 #include "design/self_collision.hpp"
 #include "design/surface_distance.hpp"
@@ -25,6 +26,19 @@ namespace balloon {
 
 std::string design_method_name(DesignMethod method) {
   return method == DesignMethod::Adjoint ? "adjoint" : "alm";
+}
+
+std::string design_stop_name(DesignStop stop) {
+  switch (stop) {
+    case DesignStop::Matched: return "matched";
+    case DesignStop::Optimal: return "optimal";
+    case DesignStop::Stalled: return "stalled";
+    case DesignStop::TimeLimit: return "time_limit";
+    case DesignStop::IterationLimit: return "iteration_limit";
+    case DesignStop::StartFailed: return "start_failed";
+    case DesignStop::Cancelled: return "cancelled";
+  }
+  return "stalled";
 }
 
 Result<DesignMethod> parse_design_method(const std::string& name) {
@@ -51,6 +65,8 @@ constexpr int STALL_ITERATIONS = 15;
 /// while (reshaping a perturbed start) is not stalled.
 constexpr double STALL_OBJECTIVE_DECREASE = 0.1;
 constexpr double MATCH_TOLERANCE_REL = 1e-4;
+/// First-order optimality: the design gradient below this fraction of its value at the start.
+constexpr double OPTIMALITY_TOLERANCE = 1e-6;
 /// A stalled design whose inflated shape is further than this (relative to the diagonal, on average)
 /// from its rigid placement on the target is re-placed and continues.
 constexpr double REALIGN_TOLERANCE_REL = 1e-4;
@@ -66,6 +82,13 @@ std::string format_fraction(double fraction) {
   char text[32];
   if (fraction >= 0.01) std::snprintf(text, sizeof(text), "%g%%", 100.0 * fraction);
   else std::snprintf(text, sizeof(text), "%.0e", fraction);
+  return text;
+}
+
+/// A ratio as a short human string: 131.4 -> "131x", 0.002 -> "0.002x".
+std::string format_ratio(double ratio) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.3gx", ratio);
   return text;
 }
 
@@ -89,6 +112,7 @@ class AdjointDesign {
         m_model(m_rest_mesh, options.material,
                 std::vector<double>(static_cast<size_t>(target.face_count()), options.thickness_mm)),
         m_solver(m_model, rigid_support(m_rest_mesh)),
+        m_sensitivity(m_model, m_solver),
         m_distance(target.vertices, target.faces, options.k_length, options.k_bending),
         m_surface(target),
         m_start_hinges(m_rest_mesh.vertices, target.faces, 0.0, REST_BENDING_WEIGHT * options.k_bending),
@@ -170,7 +194,7 @@ class AdjointDesign {
         m_distance.gradient(zz.tail(n), distance_gradient);
         distance_gradient += surface_gradient;
         gradient->resize(2 * n);
-        gradient->head(n) = rest_force_transpose(zz.head(n), zz.tail(n), w);
+        gradient->head(n) = m_sensitivity.mixed_product(zz.head(n), zz.tail(n), w, true);
         add_regularizer_gradient(zz.head(n), gradient->head(n));
         gradient->tail(n) = distance_gradient + m_solver.stiffness_times(zz.tail(n), pressure, w);
         for (Eigen::Index c2 = 0; c2 < 2 * n; ++c2)
@@ -184,15 +208,16 @@ class AdjointDesign {
     double damping = 0.0;  // Levenberg-Marquardt, relative to the mean diagonal
     int iteration = 0;
     double constraint_norm = constraints(z).norm();
-    result.message = "iteration limit reached";
+    stop_with(result, DesignStop::IterationLimit, "iteration limit reached");
     for (int outer = 0; outer < 30 && iteration < m_options.max_iterations; ++outer) {
       Eigen::VectorXd gradient;
       double value = lagrangian(z, &gradient);
       const double inner_tolerance = 1e-3 * gradient.norm();
       for (int inner = 0; inner < 20 && iteration < m_options.max_iterations; ++inner) {
-        if (m_options.cancel && m_options.cancel->cancelled()) result.message = "cancelled";
-        if (m_settings.deadline_s > 0 && now_s() > m_settings.deadline_s) result.message = "time limit reached";
-        if (result.message != "iteration limit reached") break;
+        if (m_options.cancel && m_options.cancel->cancelled()) stop_with(result, DesignStop::Cancelled, "cancelled");
+        if (m_settings.deadline_s > 0 && now_s() > m_settings.deadline_s)
+          stop_with(result, DesignStop::TimeLimit, "time limit reached");
+        if (result.stop != DesignStop::IterationLimit) break;
         ++iteration;
         Eigen::SparseMatrix<double> hessian = gauss_newton_hessian(z, pressure, mu, free);
         const double diagonal = hessian.diagonal().mean();
@@ -214,7 +239,7 @@ class AdjointDesign {
           damping *= 10.0;
         }
         if (direction.size() == 0) {
-          result.message = "the Gauss-Newton system could not be factorized";
+          stop_with(result, DesignStop::Stalled, "stalled: the Gauss-Newton system could not be factorized");
           break;
         }
         // Trust region: no vertex moves more than 2% of the target's size per step.
@@ -244,7 +269,7 @@ class AdjointDesign {
         }
         if (!accepted || gradient.norm() <= inner_tolerance) break;
       }
-      if (result.message != "iteration limit reached") break;
+      if (result.stop != DesignStop::IterationLimit) break;
       update_max_volume_term(z.head(n), start_distance, result);
       const Eigen::VectorXd c = constraints(z);
       const double new_norm = c.norm();
@@ -256,8 +281,8 @@ class AdjointDesign {
       }
       lagrangian(z, &gradient);
       if (new_norm <= 1e-6 * force_scale && gradient.norm() < 1e-4 * force_scale) {
-        result.converged = true;
-        result.message = "converged";
+        stop_with(result, DesignStop::Optimal,
+                  "optimal: force residual below 1e-6 and Lagrangian gradient below 1e-4 of the force scale");
         break;
       }
     }
@@ -272,10 +297,9 @@ class AdjointDesign {
     m_last_report = m_solver.solve_volume(x, inflated_pressure, m_target_volume, settings);
     m_x = x;
     m_pressure = inflated_pressure;
-    if (!m_last_report.converged) {
-      result.converged = false;
+    m_final_equilibrium = m_last_report.converged;
+    if (!m_last_report.converged)
       result.message += "; the final rest shape did not reach equilibrium (" + m_last_report.message + ")";
-    }
     return finish(result, rest);
   }
 
@@ -300,11 +324,11 @@ class AdjointDesign {
     for (int f = 0; f < faces.rows(); ++f) {
       const fem::Vector9d rest_corners = m_model.corners(rest, f), x_corners = m_model.corners(x, f);
       const fem::Matrix9d mixed =
-          fem::membrane_mixed_derivative(m_options.material, m_options.thickness_mm, rest_corners, x_corners);
+          fem::membrane_mixed_derivative(m_model.material(), m_model.thickness(f), rest_corners, x_corners);
       double energy = 0.0;
       fem::Vector9d element_gradient;
       fem::Matrix9d stiffness;
-      fem::membrane_energy_gradient_hessian(m_options.material, m_options.thickness_mm,
+      fem::membrane_energy_gradient_hessian(m_model.material(), m_model.thickness(f),
                                             fem::make_rest_triangle(rest_corners), x_corners, energy,
                                             element_gradient, stiffness);
       stiffness -= pressure * fem::triangle_volume_hessian(x_corners);
@@ -362,9 +386,10 @@ class AdjointDesign {
     Eigen::VectorXd gradient;
     double objective = objective_value(rest, m_x);
     if (!objective_gradient(rest, gradient)) {
-      result.message = "the adjoint system could not be factorized at the start";
+      stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized at the start");
       return finish(result, rest);
     }
+    const double initial_gradient_norm = gradient.norm();
     const double initial_objective = objective;
     build_preconditioner();
     debug_time("first gradient and preconditioner");
@@ -375,14 +400,14 @@ class AdjointDesign {
     int stall_iteration = 0;
     const double max_radius = 0.02 * result.bbox_diag_mm;  // mm
     double radius = max_radius;
-    result.message = "iteration limit reached";
+    stop_with(result, DesignStop::IterationLimit, "iteration limit reached");
     for (int iteration = 1; iteration <= m_options.max_iterations; ++iteration) {
       if (m_options.cancel && m_options.cancel->cancelled()) {
-        result.message = "cancelled";
+        stop_with(result, DesignStop::Cancelled, "cancelled");
         break;
       }
       if (m_settings.deadline_s > 0 && now_s() > m_settings.deadline_s) {
-        result.message = "time limit reached";
+        stop_with(result, DesignStop::TimeLimit, "time limit reached");
         break;
       }
       Eigen::VectorXd direction = -lbfgs_apply(memory, gradient);
@@ -404,7 +429,7 @@ class AdjointDesign {
       // just used: each trial starts Newton a second-order distance from its solution.
       Eigen::VectorXd response;
       double pressure_response = 0.0;
-      linear_response(rest, direction, response, pressure_response);
+      m_sensitivity.linear_response(direction, response, pressure_response);
       bool accepted = false;
       Eigen::VectorXd trial_rest, trial_x;
       double trial_pressure = 0.0, trial_objective = 0.0;
@@ -428,15 +453,24 @@ class AdjointDesign {
       }
       if (!accepted) {
         if (stopped()) {
-          result.message = m_last_report.message;
+          stop_with(result, m_last_report.message == "cancelled" ? DesignStop::Cancelled : DesignStop::TimeLimit,
+                    m_last_report.message);
           break;
         }
         if (!memory.empty()) {  // a stale curvature model: restart from steepest descent
           memory.clear();
           continue;
         }
-        result.converged = true;
-        result.message = "converged: no further decrease along the steepest descent";
+        // A failed line search is optimality only where the gradient has vanished; elsewhere it is a stall
+        // (a wrinkling region no trial step could balance, say), and says so.
+        if (gradient.norm() <= OPTIMALITY_TOLERANCE * initial_gradient_norm) {
+          stop_with(result, DesignStop::Optimal, "optimal: the design gradient fell below " +
+                                                     format_fraction(OPTIMALITY_TOLERANCE) + " of its start value");
+        } else {
+          stop_with(result, DesignStop::Stalled,
+                    "stalled: no decrease along the steepest descent (design gradient at " +
+                        format_ratio(gradient.norm() / initial_gradient_norm) + " its start value)");
+        }
         break;
       }
       radius = t < first_t ? t * largest : std::min(max_radius, 2.0 * radius);
@@ -454,7 +488,7 @@ class AdjointDesign {
       // The line search already evaluated this point; only a changed set of colliding pairs alters it.
       objective = colliding || was_colliding ? objective_value(rest, m_x) : trial_objective;
       if (!objective_gradient(rest, new_gradient)) {
-        result.message = "the adjoint system could not be factorized";
+        stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized");
         break;
       }
       debug_time("gradient");
@@ -471,15 +505,18 @@ class AdjointDesign {
       debug_time("surface error");
       const double relative_decrease = -t * slope / std::max(initial_objective, 1e-300);
       small_decreases = relative_decrease < 1e-7 ? small_decreases + 1 : 0;
-      if (small_decreases >= 3 || objective <= 1e-14 * initial_objective) {
-        result.converged = true;
-        result.message = "converged";
+      if (stats.avg_rel < MATCH_TOLERANCE_REL) {
+        stop_with(result, DesignStop::Matched, "matched: the inflated shape matches the target to " +
+                                                   format_fraction(MATCH_TOLERANCE_REL) + " of its bounding-box diagonal");
         break;
       }
-      if (stats.avg_rel < MATCH_TOLERANCE_REL) {
-        result.converged = true;
-        result.message = "converged: the inflated shape matches the target to " + format_fraction(MATCH_TOLERANCE_REL) +
-                         " of its bounding-box diagonal";
+      if (objective <= 1e-14 * initial_objective || gradient.norm() <= OPTIMALITY_TOLERANCE * initial_gradient_norm) {
+        stop_with(result, DesignStop::Optimal, "optimal: the design gradient fell below " +
+                                                   format_fraction(OPTIMALITY_TOLERANCE) + " of its start value");
+        break;
+      }
+      if (small_decreases >= 3) {
+        stop_with(result, DesignStop::Stalled, "stalled: the objective fell by less than 1e-7 in 3 iterations");
         break;
       }
       if (stats.avg_mm < (1.0 - STALL_IMPROVEMENT) * stall_reference) {
@@ -497,13 +534,13 @@ class AdjointDesign {
         objective = objective_value(rest, m_x);
         stall_objective = objective;
         if (!objective_gradient(rest, gradient)) {
-          result.message = "the adjoint system could not be factorized";
+          stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized");
           break;
         }
       } else if (iteration - stall_iteration >= STALL_ITERATIONS) {
-        result.converged = true;
-        result.message = "converged: the surface error improved less than " + format_fraction(STALL_IMPROVEMENT) +
-                         " in the last " + std::to_string(STALL_ITERATIONS) + " iterations";
+        stop_with(result, DesignStop::Stalled, "stalled: the surface error improved less than " +
+                                                   format_fraction(STALL_IMPROVEMENT) + " in the last " +
+                                                   std::to_string(STALL_ITERATIONS) + " iterations");
         break;
       }
     }
@@ -591,7 +628,7 @@ class AdjointDesign {
   }
 
   bool stopped() const {
-    return m_last_report.message == "cancelled" || m_last_report.message == "time limit reached";
+    return m_last_report.stop == NewtonStop::Cancelled || m_last_report.stop == NewtonStop::TimeLimit;
   }
 
   /// Volume-controlled equilibrium of `rest` from (x, p); false when it does not converge.
@@ -630,8 +667,14 @@ class AdjointDesign {
         reached = next;
         continue;
       }
-      if (stopped() || step < 1e-3 * (m_target_volume - start_volume)) {
-        result.message = "the start shape could not be inflated to the target volume (" + m_last_report.message + ")";
+      if (stopped()) {
+        stop_with(result, m_last_report.message == "cancelled" ? DesignStop::Cancelled : DesignStop::TimeLimit,
+                  m_last_report.message + " while inflating the start");
+        return false;
+      }
+      if (step < 1e-3 * (m_target_volume - start_volume)) {
+        stop_with(result, DesignStop::StartFailed,
+                  "the start shape could not be inflated to the target volume (" + m_last_report.message + ")");
         return false;
       }
       step *= 0.5;
@@ -737,21 +780,13 @@ class AdjointDesign {
   /// [K -v; -v^T 0] [lambda; mu] = [dE/dx; 0], gradient = -(d grad_x W / d rest)^T lambda.
   bool objective_gradient(const Eigen::VectorXd& rest, Eigen::VectorXd& gradient) {
     m_model.set_rest_positions(unflatten(rest));
-    if (!m_solver.factorize_exact(m_x, m_pressure)) return false;
+    if (!m_sensitivity.prepare(rest, m_x, m_pressure)) return false;
     Eigen::VectorXd distance_gradient;
     m_distance.gradient(m_x, distance_gradient);
     Eigen::VectorXd surface_gradient;
     surface_term(m_x, &surface_gradient);
     distance_gradient += surface_gradient;
-    m_volume_gradient = m_model.volume_gradient(m_x);
-    m_volume_response = m_solver.solve_with_factorization(m_volume_gradient);
-    const Eigen::VectorXd& v = m_volume_gradient;
-    const Eigen::VectorXd& b = m_volume_response;
-    const Eigen::VectorXd a = m_solver.solve_with_factorization(distance_gradient);
-    const double vb = v.dot(b);
-    if (!(std::abs(vb) > 0.0)) return false;
-    const Eigen::VectorXd lambda = a - (v.dot(a) / vb) * b;
-    gradient = -rest_force_transpose(rest, m_x, lambda);
+    gradient = m_sensitivity.gradient(distance_gradient);
     add_regularizer_gradient(rest, gradient);
     for (int c = 0; c < gradient.size(); ++c)
       if (!m_rest_free[static_cast<size_t>(c)]) gradient[c] = 0.0;
@@ -763,48 +798,6 @@ class AdjointDesign {
       if (!m_rest_free[static_cast<size_t>(c)]) w[c] = 0.0;
     gradient -= (gradient.dot(w) / w.squaredNorm()) * w;
     return gradient.allFinite();
-  }
-
-  /// sum over triangles of M_e s_e, or of M_e^T s_e with `transpose`, M_e = d grad_x W_e / d rest the
-  /// element's mixed derivative (9x9) at (rest, x): how the forces change with the rest shape (M s), and
-  /// how forces weighted by s change with it (M^T s).
-  Eigen::VectorXd mixed_product(const Eigen::VectorXd& rest, const Eigen::VectorXd& x, const Eigen::VectorXd& s,
-                                bool transpose) const {
-    Eigen::VectorXd out = Eigen::VectorXd::Zero(rest.size());
-    const Faces& faces = m_target.faces;
-    for (int f = 0; f < faces.rows(); ++f) {
-      const fem::Matrix9d mixed = fem::membrane_mixed_derivative(m_options.material, m_options.thickness_mm,
-                                                                 m_model.corners(rest, f), m_model.corners(x, f));
-      const fem::Vector9d corners = m_model.corners(s, f);
-      const fem::Vector9d product = transpose ? fem::Vector9d(mixed.transpose() * corners) : fem::Vector9d(mixed * corners);
-      for (int k = 0; k < 3; ++k) out.segment<3>(3 * faces(f, k)) += product.segment<3>(3 * k);
-    }
-    return out;
-  }
-
-  /// (d grad_x W / d rest)^T w: how forces weighted by w change with the rest shape.
-  Eigen::VectorXd rest_force_transpose(const Eigen::VectorXd& rest, const Eigen::VectorXd& x,
-                                       const Eigen::VectorXd& w) const {
-    return mixed_product(rest, x, w, true);
-  }
-
-  /// d(x, p) for a rest change `direction` at the current equilibrium, using the factorization (and v,
-  /// K^-1 v) that objective_gradient left there:
-  /// [K -v; -v^T 0] [dx; dp] = [-(d grad_x W / d rest) direction; 0].
-  void linear_response(const Eigen::VectorXd& rest, const Eigen::VectorXd& direction, Eigen::VectorXd& dx,
-                       double& dp) const {
-    const Eigen::VectorXd rhs = -mixed_product(rest, m_x, direction, false);
-    // v and K^-1 v at this equilibrium are the ones objective_gradient just computed.
-    const Eigen::VectorXd& v = m_volume_gradient;
-    const Eigen::VectorXd& b = m_volume_response;
-    const Eigen::VectorXd a = m_solver.solve_with_factorization(rhs);
-    const double vb = v.dot(b);
-    dp = std::abs(vb) > 0.0 ? -v.dot(a) / vb : 0.0;
-    dx = a + dp * b;
-    if (!dx.allFinite()) {
-      dx.setZero(rest.size());
-      dp = 0.0;
-    }
   }
 
   /// L-BFGS's initial inverse Hessian: the Gauss-Newton Hessian of E_dist at the start's inflation,
@@ -876,9 +869,25 @@ class AdjointDesign {
     m_options.progress(event);
   }
 
+  /// Sets the stop reason and its sentence.
+  static void stop_with(DesignResult& result, DesignStop stop, std::string message) {
+    result.stop = stop;
+    result.message = std::move(message);
+  }
+
+  /// The result's shapes and errors. Without an inflated start (start_failed, or stopped before it)
+  /// there is no design: the errors stay empty, the rest shape is the start, nothing is called converged.
   DesignResult& finish(DesignResult& result, const Eigen::VectorXd& rest) {
     result.rest = m_target;
     result.rest.vertices = unflatten(rest);
+    result.time_s = now_s() - m_start;
+    const bool inflated = !result.log.empty();
+    result.converged = inflated && m_final_equilibrium &&
+                       (result.stop == DesignStop::Matched || result.stop == DesignStop::Optimal);
+    if (!inflated) {
+      result.inflated = result.rest.vertices;
+      return result;
+    }
     result.inflated = rigid_align_to(unflatten(m_x), m_target.vertices);
     result.pressure_kpa = m_pressure / MPA_PER_KPA;
     result.volume_ratio = enclosed_volume(unflatten(m_x), m_target.faces) / rest_volume(rest);
@@ -890,7 +899,6 @@ class AdjointDesign {
     result.distance_energy = m_distance.value(m_x);
     m_model.set_rest_positions(result.rest.vertices);
     result.residual_norm = m_solver.residual(m_x, m_pressure).norm();
-    result.time_s = now_s() - m_start;
     return result;
   }
 
@@ -900,6 +908,7 @@ class AdjointDesign {
   TriMesh m_rest_mesh;
   fem::BalloonModel m_model;
   EquilibriumSolver m_solver;
+  AdjointSensitivity m_sensitivity;  ///< dx/drest at the current equilibrium: the gradient and the predictor
   DistanceEnergy m_distance;
   SurfaceDistance m_surface;
   std::unique_ptr<SelfCollision> m_collision;
@@ -914,11 +923,11 @@ class AdjointDesign {
   NewtonSettings m_settings;
   NewtonReport m_last_report;
   Eigen::VectorXd m_x;
-  Eigen::VectorXd m_volume_gradient, m_volume_response;  ///< v = dV/dx and K^-1 v at m_x (objective_gradient)
   double m_pressure = 0.0;
   double m_best_error = std::numeric_limits<double>::infinity();
   Eigen::VectorXd m_best_rest, m_best_x;
   double m_best_pressure = 0.0;
+  bool m_final_equilibrium = true;  ///< alm: whether the final rest shape's re-inflation converged
 };
 
 std::string options_problem(const TriMesh& target, const DesignOptions& options) {
@@ -951,6 +960,7 @@ DesignResult design_balloon(const TriMesh& target, const DesignOptions& options)
   if (auto problem = options_problem(target, options); !problem.empty()) {
     DesignResult result;
     result.method = options.method;
+    result.stop = DesignStop::StartFailed;
     result.message = problem;
     result.rest = target;
     result.inflated = target.vertices;

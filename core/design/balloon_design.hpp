@@ -1,6 +1,7 @@
 #pragma once
 /// Inverse design (paper sec. 5): the rest shape whose inflated equilibrium is closest to a target.
 /// The target must already be prepared (closed, manifold, mm; see target_preparation.hpp).
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,21 @@ enum class DesignMethod { Adjoint, AugmentedLagrangian };
 
 /// "adjoint" or "alm".
 std::string design_method_name(DesignMethod method);
+
+/// Why a design stopped. Only Matched and Optimal are convergence: each is a stated criterion.
+enum class DesignStop {
+  Matched,         ///< the average surface error fell below the match tolerance (1e-4 of the diagonal)
+  Optimal,         ///< a first-order optimality measure fell below its tolerance
+  Stalled,         ///< no progress: the line search found no decrease, or the error stopped falling
+  TimeLimit,       ///< max_time_s ran out
+  IterationLimit,  ///< max_iterations ran out
+  StartFailed,     ///< the start could not be inflated (or the options were refused): no design, no errors
+  Cancelled,       ///< the cancel token fired
+};
+
+/// The stop reason as one lower-case word: matched, optimal, stalled, time_limit, iteration_limit,
+/// start_failed, cancelled.
+std::string design_stop_name(DesignStop stop);
 Result<DesignMethod> parse_design_method(const std::string& name);
 
 struct DesignOptions {
@@ -53,8 +69,9 @@ struct ConvergenceSample {
 };
 
 struct DesignResult {
-  bool converged = false;
-  std::string message;                 ///< why it stopped
+  bool converged = false;              ///< stop is Matched or Optimal, and the returned shape is an equilibrium
+  DesignStop stop = DesignStop::StartFailed;
+  std::string message;                 ///< why it stopped, as a sentence
   DesignMethod method = DesignMethod::Adjoint;
   TriMesh rest;                        ///< the balloon to fabricate (mm)
   Positions inflated;                  ///< its predicted inflated shape, rigidly aligned to the target (mm)
@@ -62,10 +79,13 @@ struct DesignResult {
   double volume_ratio = 0.0;           ///< inflated volume / rest volume
   int iterations = 0;
   double time_s = 0.0;
-  double avg_error_mm = 0.0, max_error_mm = 0.0;  ///< inflated vertex to target surface (mm)
-  double avg_error_rel = 0.0, max_error_rel = 0.0;  ///< the same over the target's bounding-box diagonal
+  /// Inflated vertex to target surface (mm), and over the target's bounding-box diagonal. Empty when
+  /// there is no design (start_failed): a design that was never inflated has no error, not zero.
+  std::optional<double> avg_error_mm, max_error_mm;
+  std::optional<double> avg_error_rel, max_error_rel;
   double bbox_diag_mm = 0.0;
-  double baseline_avg_error_mm = 0.0, baseline_max_error_mm = 0.0;  ///< the start (downscaled target) inflated
+  /// The start (downscaled target) inflated (mm); empty when it could not be inflated.
+  std::optional<double> baseline_avg_error_mm, baseline_max_error_mm;
   double distance_energy = 0.0;        ///< E_dist at the end (mm)
   double residual_norm = 0.0;          ///< force residual of the inflated shape (N)
   /// The objective's terms and constraints that took part: "distance" always; "surface" (k_surface > 0);

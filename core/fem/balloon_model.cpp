@@ -36,7 +36,7 @@ double BalloonModel::elastic_energy(const Eigen::VectorXd& x) const {
   double total = 0.0;
   for (int f = 0; f < m_faces.rows(); ++f) {
     total += membrane_energy(m_material, m_thickness[static_cast<size_t>(f)], m_rest_triangles[static_cast<size_t>(f)],
-                             corners(x, f));
+                             corners(x, f), m_tension_field);
     if (!std::isfinite(total)) return std::numeric_limits<double>::infinity();
   }
   return total;
@@ -46,7 +46,7 @@ Eigen::VectorXd BalloonModel::elastic_gradient(const Eigen::VectorXd& x) const {
   Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
   for (int f = 0; f < m_faces.rows(); ++f) {
     const Vector9d ge = membrane_gradient(m_material, m_thickness[static_cast<size_t>(f)],
-                                          m_rest_triangles[static_cast<size_t>(f)], corners(x, f));
+                                          m_rest_triangles[static_cast<size_t>(f)], corners(x, f), m_tension_field);
     for (int k = 0; k < 3; ++k) g.segment<3>(3 * m_faces(f, k)) += ge.segment<3>(3 * k);
   }
   return g;
@@ -83,6 +83,13 @@ double BalloonModel::max_stretch(const Eigen::VectorXd& x) const {
   return std::sqrt(largest);
 }
 
+int BalloonModel::relaxed_triangle_count(const Eigen::VectorXd& x) const {
+  int count = 0;
+  for (int f = 0; f < m_faces.rows(); ++f)
+    if (is_relaxed(m_rest_triangles[static_cast<size_t>(f)], corners(x, f))) ++count;
+  return count;
+}
+
 void BalloonModel::assemble_hessian(const Eigen::VectorXd& x, double pressure_mpa, TriangleAssembly& assembly,
                                     bool project_membrane) const {
   assembly.set_zero();
@@ -93,7 +100,7 @@ void BalloonModel::assemble_hessian(const Eigen::VectorXd& x, double pressure_mp
     const Vector9d c = corners(x, f);
     membrane_energy_gradient_hessian(m_material, m_thickness[static_cast<size_t>(f)],
                                      m_rest_triangles[static_cast<size_t>(f)], c, energy, gradient, hessian,
-                                     project_membrane);
+                                     project_membrane, m_tension_field);
     if (pressure_mpa != 0.0) hessian -= pressure_mpa * triangle_volume_hessian(c);
     assembly.add(f, hessian);
   }

@@ -17,6 +17,10 @@ class BalloonModel {
   /// `element_thickness` has one entry per triangle (mm).
   BalloonModel(const TriMesh& rest, const Material& material, std::vector<double> element_thickness);
 
+  /// Switches Pipkin's tension-field relaxation on or off (off by default; see membrane_element.hpp).
+  void set_tension_field(bool on) { m_tension_field = on; }
+  bool tension_field() const { return m_tension_field; }
+
   /// Replaces the rest positions (same connectivity); the design optimizer moves them.
   void set_rest_positions(const Positions& rest);
 
@@ -42,6 +46,9 @@ class BalloonModel {
   double area(const Eigen::VectorXd& x) const;
   /// Largest principal stretch over all triangles.
   double max_stretch(const Eigen::VectorXd& x) const;
+  /// Triangles that are wrinkled or slack at x (some principal stress would be compressive); counted
+  /// whether or not the tension field is on.
+  int relaxed_triangle_count(const Eigen::VectorXd& x) const;
 
   /// Assembles the Hessian of W - p V (N/mm) into `assembly` (which is zeroed first).
   /// `project_membrane` clamps each membrane block to positive semi-definite.
@@ -55,6 +62,7 @@ class BalloonModel {
   std::vector<double> m_thickness;
   std::vector<RestTriangle> m_rest_triangles;
   double m_rest_area = 0.0;
+  bool m_tension_field = false;
 };
 
 }  // namespace balloon::fem

@@ -38,19 +38,49 @@ Eigen::Matrix<double, 3, 9> gram_jacobian(const EdgeGram& g) {
   return J;
 }
 
+/// Where a triangle sits on Pipkin's relaxed energy (see membrane_element.hpp).
+enum class TensionState { Taut, Wrinkled, Slack };
+
+/// In-plane state from tr C and det C: taut when l1 l2^2 >= 1 (both principal stresses >= 0, by the
+/// Baker-Ericksen inequality against the plane-stress direction l3 = 1/(l1 l2)), slack when l1 <= 1,
+/// wrinkled between.
+TensionState tension_state(double trace_c, double det_c) {
+  const double largest = 0.5 * trace_c + std::sqrt(std::max(0.0, 0.25 * trace_c * trace_c - det_c));
+  if (det_c >= std::sqrt(largest)) return TensionState::Taut;
+  return largest <= 1.0 ? TensionState::Slack : TensionState::Wrinkled;
+}
+
 /// W = h * A_rest * Psi(I1, I2) as a function of the Gram entries (eq. 3, 4, 11):
 /// tr C = tr(S M^-1), det C = det S / det M, I1 = tr C + 1/det C, I2 = det C + tr C / det C.
+/// With `tension_field`, Pipkin's relaxed energy: a wrinkled triangle stores the energy of uniaxial
+/// tension at its largest stretch l1 (l2 = l3 = l1^-1/2: I1 = l1^2 + 2/l1, I2 = 2 l1 + 1/l1^2), a slack
+/// one none.
 template <int N>
 Jet<N> gram_energy(const Material& material, double thickness, const Jet<N>& s11, const Jet<N>& s12,
-                   const Jet<N>& s22, const Jet<N>& m11, const Jet<N>& m12, const Jet<N>& m22) {
+                   const Jet<N>& s22, const Jet<N>& m11, const Jet<N>& m12, const Jet<N>& m22,
+                   bool tension_field = false) {
   const Jet<N> det_m = m11 * m22 - m12 * m12;
   const Jet<N> numerator = s11 * m22 - 2.0 * (s12 * m12) + s22 * m11;
   const Jet<N> trace_c = numerator / det_m;
   const Jet<N> det_s = s11 * s22 - s12 * s12;
   const Jet<N> det_c = det_s / det_m;
-  const Jet<N> inv_det_c = inverse(det_c);
-  const Jet<N> I1 = trace_c + inv_det_c;
-  const Jet<N> I2 = det_c + trace_c * inv_det_c;
+  const TensionState state = tension_field ? tension_state(trace_c.v, det_c.v) : TensionState::Taut;
+  Jet<N> I1, I2;
+  if (state == TensionState::Slack) {
+    return Jet<N>::constant(0.0);
+  } else if (state == TensionState::Wrinkled) {
+    // l1^2 = tr C / 2 + sqrt(tr C^2 / 4 - det C); the discriminant is bounded away from zero here
+    // (l2^2 < 1/l1 < l1^2), and its curvature is multiplied by dPsi/dl1^2, which vanishes at l1 = 1.
+    const Jet<N> largest = 0.5 * trace_c + sqrt(0.25 * (trace_c * trace_c) - det_c);
+    const Jet<N> l1 = sqrt(largest);
+    const Jet<N> inv_l1 = inverse(l1);
+    I1 = largest + 2.0 * inv_l1;
+    I2 = 2.0 * l1 + inv_l1 * inv_l1;
+  } else {
+    const Jet<N> inv_det_c = inverse(det_c);
+    I1 = trace_c + inv_det_c;
+    I2 = det_c + trace_c * inv_det_c;
+  }
   const InvariantDerivatives d = strain_energy(material, I1.v, I2.v);
   const Jet<N> psi = apply2(I1, I2, d.psi, d.d1, d.d2, d.d11, d.d12, d.d22);
   const Jet<N> rest_area = 0.5 * sqrt(det_m);
@@ -81,31 +111,56 @@ RestTriangle make_rest_triangle(const Vector9d& rest) {
   return t;
 }
 
-double membrane_energy(const Material& material, double thickness, const RestTriangle& rest, const Vector9d& x) {
+bool is_relaxed(const RestTriangle& rest, const Vector9d& x) {
+  const EdgeGram g = edge_gram(x);
+  const double det_m = rest.m11 * rest.m22 - rest.m12 * rest.m12;
+  const double trace_c = (g.s11 * rest.m22 - 2.0 * g.s12 * rest.m12 + g.s22 * rest.m11) / det_m;
+  const double det_c = (g.s11 * g.s22 - g.s12 * g.s12) / det_m;
+  return tension_state(trace_c, det_c) != TensionState::Taut;
+}
+
+double membrane_energy(const Material& material, double thickness, const RestTriangle& rest, const Vector9d& x,
+                       bool tension_field) {
   const EdgeGram g = edge_gram(x);
   if (collapsed(g)) return std::numeric_limits<double>::infinity();
   const double det_m = rest.m11 * rest.m22 - rest.m12 * rest.m12;
   const double trace_c = (g.s11 * rest.m22 - 2.0 * g.s12 * rest.m12 + g.s22 * rest.m11) / det_m;
   const double det_c = (g.s11 * g.s22 - g.s12 * g.s12) / det_m;
-  const double I1 = trace_c + 1.0 / det_c;
-  const double I2 = det_c + trace_c / det_c;
+  double I1 = trace_c + 1.0 / det_c;
+  double I2 = det_c + trace_c / det_c;
+  if (tension_field) {
+    switch (tension_state(trace_c, det_c)) {
+      case TensionState::Taut:
+        break;
+      case TensionState::Slack:
+        return 0.0;
+      case TensionState::Wrinkled: {
+        const double largest = 0.5 * trace_c + std::sqrt(std::max(0.0, 0.25 * trace_c * trace_c - det_c));
+        const double l1 = std::sqrt(largest);
+        I1 = largest + 2.0 / l1;
+        I2 = 2.0 * l1 + 1.0 / largest;
+        break;
+      }
+    }
+  }
   return thickness * rest.area * strain_energy(material, I1, I2).psi;
 }
 
-Vector9d membrane_gradient(const Material& material, double thickness, const RestTriangle& rest, const Vector9d& x) {
+Vector9d membrane_gradient(const Material& material, double thickness, const RestTriangle& rest, const Vector9d& x,
+                           bool tension_field) {
   // Residuals and line searches call this often: only the 3-variable jet, no 9x9 products.
   const EdgeGram g = edge_gram(x);
   if (collapsed(g)) return Vector9d::Zero();
   using J3 = Jet<3>;
   const J3 w = gram_energy<3>(material, thickness, J3::variable(g.s11, 0), J3::variable(g.s12, 1),
                               J3::variable(g.s22, 2), J3::constant(rest.m11), J3::constant(rest.m12),
-                              J3::constant(rest.m22));
+                              J3::constant(rest.m22), tension_field);
   return gram_jacobian(g).transpose() * w.g;
 }
 
 void membrane_energy_gradient_hessian(const Material& material, double thickness, const RestTriangle& rest,
                                       const Vector9d& x, double& energy, Vector9d& gradient, Matrix9d& hessian,
-                                      bool project_to_psd) {
+                                      bool project_to_psd, bool tension_field) {
   const EdgeGram g = edge_gram(x);
   if (collapsed(g)) {
     energy = std::numeric_limits<double>::infinity();
@@ -116,7 +171,7 @@ void membrane_energy_gradient_hessian(const Material& material, double thickness
   using J3 = Jet<3>;
   const J3 w = gram_energy<3>(material, thickness, J3::variable(g.s11, 0), J3::variable(g.s12, 1),
                               J3::variable(g.s22, 2), J3::constant(rest.m11), J3::constant(rest.m12),
-                              J3::constant(rest.m22));
+                              J3::constant(rest.m22), tension_field);
   const Eigen::Matrix<double, 3, 9> js = gram_jacobian(g);
   energy = w.v;
   gradient = js.transpose() * w.g;
@@ -126,7 +181,10 @@ void membrane_energy_gradient_hessian(const Material& material, double thickness
   Eigen::Matrix3d material_curvature = w.h;
   Eigen::Matrix2d stress;
   stress << 2.0 * w.g[0], w.g[1], w.g[1], 2.0 * w.g[2];
-  if (project_to_psd) {
+  // A wrinkled triangle is kept positive semi-definite always: its stress is uniaxial tension (PSD), and
+  // its energy is convex in C for neo-Hookean and the Hart-Smith presets (the clamp changes nothing);
+  // an I2 term that makes the uniaxial energy concave at large stretch (Mooney-Rivlin) is clamped.
+  if (project_to_psd || (tension_field && is_relaxed(rest, x))) {
     material_curvature = clamp_eigenvalues<3>(material_curvature);
     stress = clamp_eigenvalues<2>(stress);
   }
@@ -139,13 +197,13 @@ void membrane_energy_gradient_hessian(const Material& material, double thickness
 }
 
 Matrix9d membrane_mixed_derivative(const Material& material, double thickness, const Vector9d& rest,
-                                   const Vector9d& x) {
+                                   const Vector9d& x, bool tension_field) {
   const EdgeGram g = edge_gram(x);
   const EdgeGram m = edge_gram(rest);
   using J6 = Jet<6>;
   const J6 w = gram_energy<6>(material, thickness, J6::variable(g.s11, 0), J6::variable(g.s12, 1),
                               J6::variable(g.s22, 2), J6::variable(m.s11, 3), J6::variable(m.s12, 4),
-                              J6::variable(m.s22, 5));
+                              J6::variable(m.s22, 5), tension_field);
   // gradient_x = Js(x)^T dW/ds(s, m(rest)), so d/d(rest) = Js^T d2W/(ds dm) Jm.
   return gram_jacobian(g).transpose() * w.h.block<3, 3>(0, 3) * gram_jacobian(m);
 }

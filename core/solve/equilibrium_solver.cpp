@@ -16,10 +16,12 @@ double now_s() {
 
 bool should_stop(const NewtonSettings& settings, NewtonReport& report) {
   if (settings.cancel && settings.cancel->cancelled()) {
+    report.stop = NewtonStop::Cancelled;
     report.message = "cancelled";
     return true;
   }
   if (settings.deadline_s > 0.0 && now_s() > settings.deadline_s) {
+    report.stop = NewtonStop::TimeLimit;
     report.message = "time limit reached";
     return true;
   }
@@ -27,6 +29,19 @@ bool should_stop(const NewtonSettings& settings, NewtonReport& report) {
 }
 
 }  // namespace
+
+const char* newton_stop_word(NewtonStop stop) {
+  switch (stop) {
+    case NewtonStop::Converged: return "converged";
+    case NewtonStop::IterationLimit: return "iteration_limit";
+    case NewtonStop::LineSearchFailed: return "line_search_failed";
+    case NewtonStop::NotFactorizable: return "not_factorizable";
+    case NewtonStop::NonFinite: return "non_finite";
+    case NewtonStop::Cancelled: return "cancelled";
+    case NewtonStop::TimeLimit: return "time_limit";
+  }
+  return "unknown";
+}
 
 EquilibriumSolver::EquilibriumSolver(fem::BalloonModel& model, const std::vector<bool>& fixed_coordinate)
     : m_model(model), m_assembly(model.faces(), model.vertex_count(), fixed_coordinate) {
@@ -92,20 +107,24 @@ NewtonReport EquilibriumSolver::solve_pressure(Eigen::VectorXd& x, double pressu
     report.residual_norm = r.norm();
     const double tolerance = settings.relative_tolerance * force_scale(x, pressure_mpa);
     if (!std::isfinite(report.residual_norm)) {
+      report.stop = NewtonStop::NonFinite;
       report.message = "non-finite residual";
       return report;
     }
     if (report.residual_norm <= tolerance) {
       report.converged = true;
+      report.stop = NewtonStop::Converged;
       report.message = "converged";
       return report;
     }
     if (report.iterations >= settings.max_iterations) {
+      report.stop = NewtonStop::IterationLimit;
       report.message = "Newton iteration limit reached";
       return report;
     }
     if (should_stop(settings, report)) return report;
     if (!factorize_stiffness(x, pressure_mpa)) {
+      report.stop = NewtonStop::NotFactorizable;
       report.message = "stiffness matrix could not be factorized";
       return report;
     }
@@ -132,6 +151,7 @@ NewtonReport EquilibriumSolver::solve_pressure(Eigen::VectorXd& x, double pressu
       }
     }
     if (!accepted) {
+      report.stop = NewtonStop::LineSearchFailed;
       report.message = "line search failed";
       return report;
     }
@@ -155,16 +175,19 @@ NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressur
     report.volume_error = c;
     const double force_tolerance = settings.relative_tolerance * force_scale(x, pressure_mpa);
     if (!std::isfinite(report.residual_norm) || !std::isfinite(c)) {
+      report.stop = NewtonStop::NonFinite;
       report.message = "non-finite residual";
       return report;
     }
     if (report.residual_norm <= force_tolerance && std::abs(c) <= volume_tolerance) {
       report.unstable_modes = m_last_unstable_modes;
       report.converged = true;
+      report.stop = NewtonStop::Converged;
       report.message = "converged";
       return report;
     }
     if (report.iterations >= settings.max_iterations) {
+      report.stop = NewtonStop::IterationLimit;
       report.message = "Newton iteration limit reached";
       return report;
     }
@@ -208,6 +231,7 @@ NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressur
     // its Hessian (projected membrane blocks, a shift if needed, plus kappa v v^T by Sherman-Morrison),
     // Armijo line search on L, then the multiplier update p <- p - kappa (V - Vt).
     if (!augmented_lagrangian_step(x, pressure_mpa, target_volume, v)) {
+      report.stop = NewtonStop::LineSearchFailed;
       report.message = "line search failed";
       return report;
     }

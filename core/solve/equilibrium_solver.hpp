@@ -15,10 +15,25 @@
 
 namespace balloon {
 
+/// Why a Newton solve stopped.
+enum class NewtonStop {
+  Converged,         ///< the convergence test held (see NewtonSettings)
+  IterationLimit,    ///< max_iterations reached without convergence
+  LineSearchFailed,  ///< no step decreased the merit even with the strongest proximal damping
+  NotFactorizable,   ///< the (shifted) stiffness could not be factorized
+  NonFinite,         ///< the residual became NaN or infinite
+  Cancelled,         ///< the cancel token fired
+  TimeLimit,         ///< the deadline passed
+};
+
+/// One word per stop reason ("converged", "iteration_limit", ...), for reports.
+const char* newton_stop_word(NewtonStop stop);
+
 /// Outcome of one Newton solve.
 struct NewtonReport {
   bool converged = false;
-  std::string message;
+  NewtonStop stop = NewtonStop::IterationLimit;
+  std::string message;  ///< the stop reason as a sentence (unchanged CLI text)
   int iterations = 0;
   double residual_norm = 0.0;  ///< |grad W - p grad V| over the free coordinates (N)
   double volume_error = 0.0;   ///< V - V_target (mm^3), volume control only
@@ -27,8 +42,12 @@ struct NewtonReport {
   int unstable_modes = 0;
 };
 
+/// Convergence test: |r| <= relative_tolerance * F with the force scale F = |p| |grad V| + 1e-3 G h sqrt(A)
+/// (G the small-strain shear modulus, h the mean thickness, A the rest area: a thousandth of the membrane
+/// force a unit strain would cause), so the test keeps its meaning near zero pressure; under volume
+/// control also |V - V_target| <= relative_tolerance * V_target.
 struct NewtonSettings {
-  double relative_tolerance = 1e-8;  ///< |r| <= tol * (p |grad V| + force floor)
+  double relative_tolerance = 1e-8;  ///< see above
   int max_iterations = 30;
   const CancelToken* cancel = nullptr;
   double deadline_s = 0.0;  ///< absolute time (steady clock seconds) after which to stop; 0 = none
@@ -68,11 +87,11 @@ class EquilibriumSolver {
   /// Factorizes K, or K + shift I with the smallest shift found that makes it positive definite.
   bool factorize_stiffness(const Eigen::VectorXd& x, double pressure_mpa);
 
-  /// Exact stiffness for the volume-controlled KKT step, accepted when its inertia is right.
-  bool factorize_exact_for_volume(const Eigen::VectorXd& x, double pressure_mpa, const Eigen::VectorXd& v);
   /// One robust augmented-Lagrangian step for volume control (see solve_volume).
   bool augmented_lagrangian_step(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
                                  const Eigen::VectorXd& v);
+  /// Exact stiffness for the volume-controlled KKT step, accepted when its inertia is right.
+  bool factorize_exact_for_volume(const Eigen::VectorXd& x, double pressure_mpa, const Eigen::VectorXd& v);
 
   fem::BalloonModel& m_model;
   fem::TriangleAssembly m_assembly;

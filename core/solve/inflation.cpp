@@ -18,6 +18,13 @@ double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+std::string format_number(double value) {
+  std::ostringstream out;
+  out.precision(3);
+  out << value;
+  return out.str();
+}
+
 std::string format_kpa(double mpa) {
   std::ostringstream out;
   out.precision(4);
@@ -45,6 +52,7 @@ class InflationRun {
     m_settings.max_iterations = 60;
     m_settings.cancel = options.cancel;
     m_settings.deadline_s = options.max_time_s > 0 ? m_start + options.max_time_s : 0.0;
+    m_model.set_tension_field(options.tension_field);
   }
 
   InflationResult run(const Positions* initial_guess) {
@@ -55,6 +63,7 @@ class InflationRun {
     bool ok = true;
     if (!(result.rest_volume_mm3 > 0.0)) {
       ok = false;
+      m_stop = InflationStop::InvalidInput;
       result.message = "the rest mesh encloses no positive volume (open, flat or oriented inwards)";
     } else {
       if (initial_guess) {
@@ -68,6 +77,7 @@ class InflationRun {
         ok = inflate_to_pressure(state, m_options.pressure_kpa * MPA_PER_KPA, result.message);
     }
     result.converged = ok;
+    result.stop = ok ? InflationStop::Converged : m_stop;
     if (ok) result.message = "converged";
     fill(result, state);
     return result;
@@ -156,8 +166,11 @@ class InflationRun {
     return true;
   }
 
-  bool stopped(const NewtonReport& report) const {
-    return report.message == "cancelled" || report.message == "time limit reached";
+  /// Cancelled or out of time: the run ends there (and m_stop says which).
+  bool stopped(const NewtonReport& report) {
+    if (report.stop == NewtonStop::Cancelled) m_stop = InflationStop::Cancelled;
+    if (report.stop == NewtonStop::TimeLimit) m_stop = InflationStop::TimeLimit;
+    return report.stop == NewtonStop::Cancelled || report.stop == NewtonStop::TimeLimit;
   }
 
   bool inflate_to_volume(PathPoint& state, double target_volume, std::string& message) {
@@ -182,8 +195,9 @@ class InflationRun {
       }
       step *= 0.5;
       if (std::abs(step) < smallest) {
-        message = "no equilibrium found at volume ratio " + std::to_string(next / m_model.volume(flat_rest())) +
-                  " (" + report.message + ", residual " + std::to_string(report.residual_norm) + " N)";
+        message = "no equilibrium found at volume ratio " + format_number(next / m_model.volume(flat_rest())) +
+                  " (" + report.message + ", residual " + format_number(report.residual_norm) + " N against a tolerance of " +
+                  format_number(m_settings.relative_tolerance * m_solver.force_scale(state.x, state.pressure)) + " N)";
         return false;
       }
     }
@@ -221,6 +235,7 @@ class InflationRun {
       }
       peak_pressure = std::max(peak_pressure, state.pressure);
       if (state.pressure < previous.pressure && previous.pressure < target_pressure) {
+        m_stop = InflationStop::AboveMaximumPressure;
         message = "no equilibrium: " + format_kpa(target_pressure) + " exceeds the balloon's maximum pressure of about " +
                   format_kpa(peak_pressure) + " (use volume control to pass it)";
         return false;
@@ -237,7 +252,7 @@ class InflationRun {
         m_newton_iterations += report.iterations;
         if (!report.converged) {
           message = "no equilibrium found at " + format_kpa(target_pressure) + " (" + report.message + ", residual " +
-                    std::to_string(report.residual_norm) + " N)";
+                    format_number(report.residual_norm) + " N)";
           state.x = x;
           state.pressure = target_pressure;
           state.volume = m_model.volume(x);
@@ -263,6 +278,7 @@ class InflationRun {
     for (int v : m_options.fixed_vertices) r.segment<3>(3 * v).setZero();
     result.residual_norm = r.norm();
     result.unstable_modes = m_unstable_modes;
+    result.wrinkled_elements = m_model.tension_field() ? m_model.relaxed_triangle_count(state.x) : 0;
     result.newton_iterations = m_newton_iterations;
     result.factorizations = m_solver.factorizations();
     result.load_steps = m_load_steps;
@@ -279,6 +295,7 @@ class InflationRun {
   int m_newton_iterations = 0;
   int m_load_steps = 0;
   int m_unstable_modes = 0;
+  InflationStop m_stop = InflationStop::NoEquilibrium;
 };
 
 std::string options_problem(const TriMesh& rest, const InflationOptions& options) {
@@ -306,9 +323,22 @@ std::string options_problem(const TriMesh& rest, const InflationOptions& options
 
 }  // namespace
 
+const char* inflation_stop_word(InflationStop stop) {
+  switch (stop) {
+    case InflationStop::Converged: return "converged";
+    case InflationStop::InvalidInput: return "invalid_input";
+    case InflationStop::AboveMaximumPressure: return "above_max_pressure";
+    case InflationStop::NoEquilibrium: return "no_equilibrium";
+    case InflationStop::Cancelled: return "cancelled";
+    case InflationStop::TimeLimit: return "time_limit";
+  }
+  return "unknown";
+}
+
 InflationResult inflate(const TriMesh& rest, const InflationOptions& options, const Positions* initial_guess) {
   if (auto problem = options_problem(rest, options); !problem.empty()) {
     InflationResult result;
+    result.stop = InflationStop::InvalidInput;
     result.message = problem;
     result.deformed = rest.vertices;
     return result;

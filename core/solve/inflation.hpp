@@ -24,12 +24,31 @@ struct InflationOptions {
   double residual_tolerance = 1e-8;          ///< stop when |f| <= tol * (p * A_rest), relative force residual
   int max_newton_iterations = 200;           ///< over all load steps
   double max_time_s = 0.0;                   ///< wall-time budget (s); 0 means none
+  /// Pipkin's tension-field relaxation (fem/membrane_element.hpp): compressed triangles wrinkle instead
+  /// of carrying compressive stress; it changes nothing where the membrane is taut. Off by default:
+  /// on bench_robustness it cures some shapes and slows others, because slack regions are mechanisms
+  /// (zero stiffness) near zero pressure (README, "Robustness").
+  bool tension_field = false;
   ProgressCallback progress;                 ///< optional
   const CancelToken* cancel = nullptr;       ///< optional
 };
 
+/// Why an inflation stopped.
+enum class InflationStop {
+  Converged,             ///< an equilibrium at the requested volume or pressure (NewtonSettings' test)
+  InvalidInput,          ///< the options or the rest mesh were rejected before any work
+  AboveMaximumPressure,  ///< pressure control asked for more than the balloon's pressure maximum
+  NoEquilibrium,         ///< the load path could not be continued (the message says where and why)
+  Cancelled,
+  TimeLimit,
+};
+
+/// One word per stop reason ("converged", "above_max_pressure", ...), for reports.
+const char* inflation_stop_word(InflationStop stop);
+
 struct InflationResult {
   bool converged = false;
+  InflationStop stop = InflationStop::NoEquilibrium;
   std::string message;            ///< why it stopped; names the failure when not converged
   Positions deformed;             ///< #V by 3 equilibrium positions (mm)
   double pressure_kpa = 0.0;      ///< equilibrium pressure (kPa)
@@ -40,6 +59,7 @@ struct InflationResult {
   double max_stretch = 0.0;       ///< largest principal stretch over all triangles
   double residual_norm = 0.0;     ///< |f_mem + f_p| over all free coordinates (N)
   int unstable_modes = 0;         ///< volume control: unstable directions of the equilibrium (0 = stable)
+  int wrinkled_elements = 0;      ///< triangles the tension field relaxed at the end (wrinkled or slack); 0 when it is off
   int newton_iterations = 0;
   int factorizations = 0;
   int load_steps = 0;

@@ -21,7 +21,9 @@
 #include "http/event_stream.hpp"
 #include "http/job_files.hpp"
 #include "http/json_mapping.hpp"
+#include "http/origin_policy.hpp"
 #include "http/static_files.hpp"
+#include "net/network_address.hpp"
 
 namespace balloon::http {
 namespace {
@@ -40,8 +42,9 @@ constexpr auto EVENT_POLL = std::chrono::milliseconds(250);
 
 bool is_api_path(const std::string& path) { return path == "/api" || path.rfind("/api/", 0) == 0; }
 
-void send_error(httplib::Response& res, grpc::StatusCode code, const std::string& message) {
-  res.status = http_status_for(code);
+/// The API's error body; `http_status` overrides the status the code maps to (415 has no gRPC code).
+void send_error(httplib::Response& res, grpc::StatusCode code, const std::string& message, int http_status = 0) {
+  res.status = http_status != 0 ? http_status : http_status_for(code);
   res.set_header("Cache-Control", "no-store");
   res.set_content(error_body(code, message), JSON_TYPE);
 }
@@ -119,8 +122,36 @@ bool peer_closed(int fd) {
   return poll(&entry, 1, 0) > 0 && (entry.revents & (POLLRDHUP | POLLHUP | POLLERR | POLLNVAL)) != 0;
 }
 
+/// True for a `Content-Type` naming JSON: "application/json", any case, parameters such as charset allowed.
+bool is_json_content_type(const std::string& value) {
+  std::string media = value.substr(0, value.find(';'));
+  while (!media.empty() && (media.back() == ' ' || media.back() == '\t')) media.pop_back();
+  for (char& c : media) c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
+  return media == JSON_TYPE;
+}
+
+/// One place among the open event streams, given back when the stream's response is destroyed.
+class StreamSlot {
+ public:
+  /// A slot if fewer than `limit` are taken, else nullptr.
+  static std::unique_ptr<StreamSlot> take(std::atomic<int>& open, int limit) {
+    int now = open.load();
+    while (now < limit)
+      if (open.compare_exchange_weak(now, now + 1)) return std::unique_ptr<StreamSlot>(new StreamSlot(open));
+    return nullptr;
+  }
+  ~StreamSlot() { --m_open; }
+  StreamSlot(const StreamSlot&) = delete;
+  StreamSlot& operator=(const StreamSlot&) = delete;
+
+ private:
+  explicit StreamSlot(std::atomic<int>& open) : m_open(open) {}
+  std::atomic<int>& m_open;
+};
+
 /// One open Server-Sent-Events response.
 struct SseState {
+  std::unique_ptr<StreamSlot> slot;
   std::shared_ptr<JobEventStream> stream;
   int socket = -1;
   Clock::time_point last_write = Clock::now();
@@ -129,34 +160,13 @@ struct SseState {
 
 }  // namespace
 
-Result<std::pair<std::string, int>> split_host_port(const std::string& address) {
-  std::string host, port_text;
-  if (!address.empty() && address.front() == '[') {
-    const auto close = address.find(']');
-    if (close == std::string::npos || close + 1 >= address.size() || address[close + 1] != ':')
-      return fail("HTTP address '" + address + "' must read [V6ADDRESS]:PORT");
-    host = address.substr(1, close - 1);
-    port_text = address.substr(close + 2);
-  } else {
-    const auto colon = address.rfind(':');
-    if (colon == std::string::npos || colon == 0) return fail("HTTP address '" + address + "' must read HOST:PORT");
-    host = address.substr(0, colon);
-    port_text = address.substr(colon + 1);
-    if (host.find(':') != std::string::npos)
-      return fail("HTTP address '" + address + "': write an IPv6 host in brackets, [V6ADDRESS]:PORT");
-  }
-  char* end = nullptr;
-  const long port = std::strtol(port_text.c_str(), &end, 10);
-  if (port_text.empty() || *end != '\0' || port < 0 || port > 65535)
-    return fail("HTTP address '" + address + "': port '" + port_text + "' is not a number in 0..65535");
-  return std::make_pair(host, static_cast<int>(port));
-}
-
 struct HttpGateway::Internals {
   HttpGatewayOptions options;
   std::shared_ptr<grpc::Channel> channel;
   std::unique_ptr<Stub> stub;
-  httplib::Server server;
+  std::unique_ptr<OriginPolicy> policy;     ///< set before the first request (it needs the bound port)
+  std::atomic<int> open_streams{0};         ///< event streams holding a worker thread
+  std::unique_ptr<httplib::Server> server;  ///< an httplib::SSLServer with TLS
   std::thread listener;
   int port = 0;
 
@@ -169,6 +179,43 @@ struct HttpGateway::Internals {
 
   void log(const std::string& line) const {
     if (options.log) options.log(line);
+  }
+
+  /// False (403 or 415 written) for a request this gateway must not serve: a Host or Origin the policy
+  /// refuses (DNS rebinding, another site's page), or a body that is not declared JSON (a form or
+  /// `text/plain` POST, which browsers send cross-site without asking first).
+  bool admit(const httplib::Request& req, httplib::Response& res) const {
+    if (req.get_header_value_count("Host") > 1 || req.get_header_value_count("Origin") > 1) {
+      send_error(res, grpc::StatusCode::INVALID_ARGUMENT, "the request repeats its Host or Origin header");
+      return false;
+    }
+    const std::string host = req.get_header_value("Host"), origin = req.get_header_value("Origin");
+    const std::string refusal =
+        policy->refusal(req.has_header("Host") ? &host : nullptr, req.has_header("Origin") ? &origin : nullptr);
+    if (!refusal.empty()) {
+      send_error(res, grpc::StatusCode::PERMISSION_DENIED, refusal);
+      return false;
+    }
+    const bool may_write = req.method != "GET" && req.method != "HEAD" && req.method != "OPTIONS";
+    if (may_write && (!req.body.empty() || req.has_header("Content-Type")) &&
+        !is_json_content_type(req.get_header_value("Content-Type"))) {
+      std::string got = req.get_header_value("Content-Type").substr(0, 80);
+      for (char& c : got)
+        if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) c = '?';
+      send_error(res, grpc::StatusCode::INVALID_ARGUMENT,
+                 "a request body must be JSON sent with 'Content-Type: application/json'" +
+                     (req.has_header("Content-Type") ? " (got '" + got + "')" : std::string(" (no Content-Type)")),
+                 415);
+      return false;
+    }
+    return true;
+  }
+
+  /// `handler` behind admit().
+  httplib::Server::Handler admitted(std::function<void(const httplib::Request&, httplib::Response&)> handler) {
+    return [this, handler = std::move(handler)](const httplib::Request& req, httplib::Response& res) {
+      if (admit(req, res)) handler(req, res);
+    };
   }
 
   /// A context carrying the request's Authorization; false (response written) on a malformed header.
@@ -272,6 +319,11 @@ struct HttpGateway::Internals {
 
   void watch_events(const httplib::Request& req, httplib::Response& res) {
     const std::string job_id = req.matches[1];
+    std::unique_ptr<StreamSlot> slot = StreamSlot::take(open_streams, options.max_event_streams);
+    if (!slot)
+      return send_error(res, grpc::StatusCode::UNAVAILABLE,
+                        "too many open event streams (" + std::to_string(options.max_event_streams) +
+                            ", --http-max-event-streams): close one or try again later");
     std::string authorization;
     if (!authorization_of(req, res, &authorization)) return;
     // The job is looked up first so that a bad token or an unknown id is an HTTP error, not a stream
@@ -286,6 +338,7 @@ struct HttpGateway::Internals {
       if (!status.ok()) return send_status(res, status);
     }
     auto state = std::make_shared<SseState>();
+    state->slot = std::move(slot);
     {
       std::lock_guard lock(streams_mutex);
       if (stopping) return send_error(res, grpc::StatusCode::UNAVAILABLE, "the server is shutting down");
@@ -363,53 +416,55 @@ struct HttpGateway::Internals {
   }
 
   void register_routes() {
-    server.Get("/api/v1/health", [](const httplib::Request&, httplib::Response& res) {
+    // Not behind the Host/Origin check: it tells nothing a rebinding page could use, and balancers and
+    // probes call it by address, with a Host no gateway can predict.
+    server->Get("/api/v1/health", [](const httplib::Request&, httplib::Response& res) {
       res.set_header("Cache-Control", "no-store");
       res.set_content("{\"status\":\"ok\"}", JSON_TYPE);
     });
-    server.Get("/api/v1/materials", [this](const httplib::Request& req, httplib::Response& res) {
+    server->Get("/api/v1/materials", admitted([this](const httplib::Request& req, httplib::Response& res) {
       unary(req, res, v1::ListMaterialsRequest(), &Stub::ListMaterials);
-    });
-    server.Get(R"(/api/v1/materials/([^/]+))", [this](const httplib::Request& req, httplib::Response& res) {
+    }));
+    server->Get(R"(/api/v1/materials/([^/]+))", admitted([this](const httplib::Request& req, httplib::Response& res) {
       v1::GetMaterialRequest request;
       request.set_name(req.matches[1]);
       unary(req, res, request, &Stub::GetMaterial);
-    });
-    server.Put(R"(/api/v1/materials/([^/]+))",
-               [this](const httplib::Request& req, httplib::Response& res) { put_material(req, res); });
-    server.Delete(R"(/api/v1/materials/([^/]+))", [this](const httplib::Request& req, httplib::Response& res) {
+    }));
+    server->Put(R"(/api/v1/materials/([^/]+))",
+               admitted([this](const httplib::Request& req, httplib::Response& res) { put_material(req, res); }));
+    server->Delete(R"(/api/v1/materials/([^/]+))", admitted([this](const httplib::Request& req, httplib::Response& res) {
       v1::DeleteMaterialRequest request;
       request.set_name(req.matches[1]);
       unary(req, res, request, &Stub::DeleteMaterial);
-    });
-    server.Post("/api/v1/jobs", [this](const httplib::Request& req, httplib::Response& res) {
+    }));
+    server->Post("/api/v1/jobs", admitted([this](const httplib::Request& req, httplib::Response& res) {
       v1::SubmitJobRequest request;
       if (!parse_body(req, res, &request)) return;
       unary(req, res, request, &Stub::SubmitJob);
-    });
-    server.Get("/api/v1/jobs", [this](const httplib::Request& req, httplib::Response& res) { list_jobs(req, res); });
-    server.Get(R"(/api/v1/jobs/([^/]+))", [this](const httplib::Request& req, httplib::Response& res) {
+    }));
+    server->Get("/api/v1/jobs", admitted([this](const httplib::Request& req, httplib::Response& res) { list_jobs(req, res); }));
+    server->Get(R"(/api/v1/jobs/([^/]+))", admitted([this](const httplib::Request& req, httplib::Response& res) {
       v1::GetJobRequest request;
       request.set_job_id(req.matches[1]);
       unary(req, res, request, &Stub::GetJob);
-    });
-    server.Post(R"(/api/v1/jobs/([^/]+)/cancel)", [this](const httplib::Request& req, httplib::Response& res) {
+    }));
+    server->Post(R"(/api/v1/jobs/([^/]+)/cancel)", admitted([this](const httplib::Request& req, httplib::Response& res) {
       v1::CancelJobRequest request;  // the body, if any ("{}"), carries nothing
       request.set_job_id(req.matches[1]);
       unary(req, res, request, &Stub::CancelJob);
-    });
-    server.Get(R"(/api/v1/jobs/([^/]+)/result)",
-               [this](const httplib::Request& req, httplib::Response& res) { get_result(req, res); });
-    server.Get(R"(/api/v1/jobs/([^/]+)/events)",
-               [this](const httplib::Request& req, httplib::Response& res) { watch_events(req, res); });
-    server.Get(R"(/api/v1/jobs/([^/]+)/files/([^/]+))",
-               [this](const httplib::Request& req, httplib::Response& res) { get_file(req, res); });
+    }));
+    server->Get(R"(/api/v1/jobs/([^/]+)/result)",
+               admitted([this](const httplib::Request& req, httplib::Response& res) { get_result(req, res); }));
+    server->Get(R"(/api/v1/jobs/([^/]+)/events)",
+               admitted([this](const httplib::Request& req, httplib::Response& res) { watch_events(req, res); }));
+    server->Get(R"(/api/v1/jobs/([^/]+)/files/([^/]+))",
+               admitted([this](const httplib::Request& req, httplib::Response& res) { get_file(req, res); }));
     // Everything else is the page (registered last: handlers match in order).
-    server.Get(".*", [this](const httplib::Request& req, httplib::Response& res) { serve_static(req, res); });
+    server->Get(".*", admitted([this](const httplib::Request& req, httplib::Response& res) { serve_static(req, res); }));
 
     // Responses httplib makes itself (no route, body too large, unreadable request) get the API's error
     // body under /api and plain text elsewhere. Responses with a body are ours: left alone.
-    server.set_error_handler(httplib::Server::HandlerWithResponse([this](const httplib::Request& req,
+    server->set_error_handler(httplib::Server::HandlerWithResponse([this](const httplib::Request& req,
                                                                          httplib::Response& res) {
       if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
       grpc::StatusCode code = grpc::StatusCode::INTERNAL;
@@ -437,7 +492,7 @@ struct HttpGateway::Internals {
       }
       return httplib::Server::HandlerResponse::Handled;
     }));
-    server.set_exception_handler([this](const httplib::Request& req, httplib::Response& res, std::exception_ptr error) {
+    server->set_exception_handler([this](const httplib::Request& req, httplib::Response& res, std::exception_ptr error) {
       std::string what = "unknown exception";
       try {
         if (error) std::rethrow_exception(error);
@@ -457,34 +512,58 @@ HttpGateway::~HttpGateway() { stop(); }
 
 Result<std::unique_ptr<HttpGateway>> HttpGateway::start(const HttpGatewayOptions& options,
                                                         std::shared_ptr<grpc::Channel> channel) {
-  Result<std::pair<std::string, int>> where = split_host_port(options.address);
+  Result<std::pair<std::string, int>> where = net::split_host_port(options.address, "HTTP address");
   if (!where) return fail(where.error());
   if (options.threads < 2) return fail("the HTTP gateway needs at least 2 threads");
+  if (options.max_event_streams < 1) return fail("the HTTP gateway needs room for at least 1 event stream");
+  std::vector<WebOrigin> allowed;
+  for (const std::string& text : options.allowed_origins) {
+    Result<WebOrigin> origin = parse_origin(text);
+    if (!origin) return fail("--http-allowed-origin: " + origin.error());
+    allowed.push_back(*origin);
+  }
+  const bool tls = !options.tls_cert_file.empty() || !options.tls_key_file.empty();
   auto internals = std::make_unique<Internals>();
+  if (tls) {
+    if (options.tls_cert_file.empty() || options.tls_key_file.empty())
+      return fail("HTTPS needs both --http-tls-cert and --http-tls-key");
+    for (const std::string* file : {&options.tls_cert_file, &options.tls_key_file})
+      if (!std::ifstream(*file)) return fail("cannot read HTTP TLS file '" + *file + "'");
+    auto server = std::make_unique<httplib::SSLServer>(options.tls_cert_file.c_str(), options.tls_key_file.c_str());
+    if (!server->is_valid())
+      return fail("cannot use '" + options.tls_cert_file + "' and '" + options.tls_key_file +
+                  "' as the HTTP TLS certificate chain and key (PEM files of a matching pair expected)");
+    internals->server = std::move(server);
+  } else {
+    internals->server = std::make_unique<httplib::Server>();
+  }
   internals->options = options;
   internals->channel = std::move(channel);
   internals->stub = v1::BalloonService::NewStub(internals->channel);
-  const auto threads = static_cast<size_t>(options.threads);
-  internals->server.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
-  internals->server.set_payload_max_length(options.max_body_bytes);
+  // Event streams hold a thread each, and there are at most max_event_streams of them: the rest of the
+  // pool always serves the other requests.
+  const auto threads = static_cast<size_t>(options.threads) + static_cast<size_t>(options.max_event_streams);
+  internals->server->new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+  internals->server->set_payload_max_length(options.max_body_bytes);
   internals->register_routes();
 
   const auto& [host, port] = *where;
   if (port == 0) {
-    internals->port = internals->server.bind_to_any_port(host);
+    internals->port = internals->server->bind_to_any_port(host);
     if (internals->port < 0) return fail("cannot listen on HTTP address '" + options.address + "'");
   } else {
-    if (!internals->server.bind_to_port(host, port))
+    if (!internals->server->bind_to_port(host, port))
       return fail("cannot listen on HTTP address '" + options.address + "' (address in use or invalid)");
     internals->port = port;
   }
+  internals->policy = std::make_unique<OriginPolicy>(tls, internals->port, std::move(allowed));
   Internals* raw = internals.get();
-  internals->listener = std::thread([raw] { raw->server.listen_after_bind(); });
+  internals->listener = std::thread([raw] { raw->server->listen_after_bind(); });
   // stop() is a no-op until the server runs: wait for it so that a quick stop cannot be lost.
   const auto deadline = Clock::now() + std::chrono::seconds(10);
-  while (!internals->server.is_running() && Clock::now() < deadline)
+  while (!internals->server->is_running() && Clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  if (!internals->server.is_running()) {
+  if (!internals->server->is_running()) {
     internals->listener.join();  // listen_after_bind returned: it failed
     return fail("the HTTP server on '" + options.address + "' did not start");
   }
@@ -505,7 +584,7 @@ void HttpGateway::stop() {
       if (auto stream = weak.lock()) stream->cancel();
     m_internals->streams.clear();
   }
-  m_internals->server.stop();
+  m_internals->server->stop();
   if (m_internals->listener.joinable()) m_internals->listener.join();
 }
 

@@ -207,12 +207,22 @@ DesignOutcome run_design(const DesignInput& input, const RunControls& controls) 
   return outcome;
 }
 
+std::string design_error_summary(const DesignResult& result) {
+  if (!result.avg_error_mm || !result.avg_error_rel)
+    return "no design error (stop reason " + design_stop_name(result.stop) + ")";
+  char text[128];
+  std::snprintf(text, sizeof(text), "avg error %.3g mm (%.2g%% of %.3g mm)", *result.avg_error_mm,
+                100.0 * *result.avg_error_rel, result.bbox_diag_mm);
+  return text;
+}
+
 std::string design_report_json(const DesignInput& input, const DesignOutcome& outcome) {
   const DesignResult& result = outcome.result;
   const PreparedTarget& target = input.target;
   JsonWriter json;
   json.begin_object()
       .value("converged", result.converged)
+      .value("stop_reason", design_stop_name(result.stop))
       .value("method", design_method_name(result.method))
       .value("avg_error_mm", result.avg_error_mm)
       .value("max_error_mm", result.max_error_mm)
@@ -228,11 +238,15 @@ std::string design_report_json(const DesignInput& input, const DesignOutcome& ou
   json.begin_array("active_terms");
   for (const std::string& term : result.active_terms) json.value("", term);
   json.end_array();
+  // Ratios of values that exist; null otherwise (no baseline, no design, or a design with zero error).
+  const auto ratio = [](const std::optional<double>& a, const std::optional<double>& b) -> std::optional<double> {
+    if (!a || !b || !(*b > 0.0)) return std::nullopt;
+    return *a / *b;
+  };
   json.value("baseline_avg_error_mm", result.baseline_avg_error_mm)
       .value("baseline_max_error_mm", result.baseline_max_error_mm)
-      .value("baseline_avg_error_rel", result.bbox_diag_mm > 0 ? result.baseline_avg_error_mm / result.bbox_diag_mm : 0.0)
-      .value("improvement_over_baseline",
-             result.avg_error_mm > 0 ? result.baseline_avg_error_mm / result.avg_error_mm : 0.0)
+      .value("baseline_avg_error_rel", ratio(result.baseline_avg_error_mm, result.bbox_diag_mm))
+      .value("improvement_over_baseline", ratio(result.baseline_avg_error_mm, result.avg_error_mm))
       .value("distance_energy", result.distance_energy)
       .value("residual_norm", result.residual_norm)
       .value("material", material_spec(input.material))

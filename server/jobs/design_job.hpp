@@ -90,6 +90,10 @@ Result<TriMesh> design_mold(const TriMesh& rest, const MoldParameters& mold);
 /// then carries the report's mold_problem), is not a design report, or the tube cannot be built.
 Result<TriMesh> mold_from_report(const TriMesh& rest, const std::string& report_json);
 
+/// "avg error 0.12 mm (0.1% of 120 mm)", or "no design error (stop reason start_failed)" when there
+/// is none: for logs and the COMPLETED event's message.
+std::string design_error_summary(const DesignResult& result);
+
 /// One JSON object. Issue 4's keys: converged, method, avg_error_mm, max_error_mm, avg_error_rel,
 /// max_error_rel, bbox_diag_mm, pressure_kpa, volume_ratio, iterations, time_s, vertices, active_terms,
 /// baseline_avg_error_mm, baseline_max_error_mm; also faces, material, material_name, thickness_mm,

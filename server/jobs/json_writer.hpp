@@ -1,6 +1,7 @@
 #pragma once
 /// A small streaming JSON writer for reports: objects, arrays, strings, numbers, booleans.
 /// Non-finite numbers are written as null (JSON has no NaN), so a report is always valid JSON.
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -24,6 +25,10 @@ class JsonWriter {
   JsonWriter& value(std::string_view key, int number) { return value(key, static_cast<long long>(number)); }
   JsonWriter& value(std::string_view key, long long number);
   JsonWriter& value(std::string_view key, bool flag);
+  /// A number, or null when there is none (a value that was never computed is null, never 0).
+  JsonWriter& value(std::string_view key, const std::optional<double>& number) {
+    return number ? value(key, *number) : raw(key, "null");
+  }
   /// Inserts already-serialized JSON (trusted, e.g. a stored report) as a member or element.
   JsonWriter& raw(std::string_view key, std::string_view json);
 

@@ -112,6 +112,7 @@ BalloonServiceImpl::BalloonServiceImpl(service::JobHandler& jobs, service::Mater
 grpc::Status BalloonServiceImpl::authenticate(grpc::ServerContextBase* context, service::Caller* caller) const {
   if (m_tokens == nullptr) {
     caller->tenant = service::LOCAL_TENANT;
+    caller->may_raise_priority = true;
     return grpc::Status::OK;
   }
   const auto& metadata = context->client_metadata();
@@ -121,9 +122,9 @@ grpc::Status BalloonServiceImpl::authenticate(grpc::ServerContextBase* context, 
   const std::string_view value(it->second.data(), it->second.size());
   if (value.substr(0, BEARER.size()) != BEARER)
     return grpc::Status(grpc::StatusCode::UNAUTHENTICATED, "authorization metadata must read 'Bearer <token>'");
-  const std::optional<std::string> tenant = m_tokens->tenant_for(value.substr(BEARER.size()));
-  if (!tenant) return grpc::Status(grpc::StatusCode::UNAUTHENTICATED, "unknown token");
-  caller->tenant = *tenant;
+  const std::optional<service::Caller> found = m_tokens->caller_for(value.substr(BEARER.size()));
+  if (!found) return grpc::Status(grpc::StatusCode::UNAUTHENTICATED, "unknown token");
+  *caller = *found;
   return grpc::Status::OK;
 }
 

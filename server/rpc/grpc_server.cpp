@@ -7,6 +7,7 @@
 #include <mutex>
 #include <sstream>
 
+#include "net/network_address.hpp"
 #include "rpc/balloon_service_impl.hpp"
 #include "service/job_handler.hpp"
 #include "service/material_handler.hpp"
@@ -25,17 +26,6 @@ Result<std::string> read_file(const std::string& path, const std::string& what) 
 }
 
 }  // namespace
-
-bool is_loopback_address(const std::string& address) {
-  if (address.rfind("unix:", 0) == 0) return true;
-  std::string host;
-  if (!address.empty() && address.front() == '[') {
-    host = address.substr(1, address.find(']') == std::string::npos ? std::string::npos : address.find(']') - 1);
-  } else {
-    host = address.substr(0, address.rfind(':'));
-  }
-  return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
-}
 
 struct GrpcServer::Internals {
   std::unique_ptr<store::Store> store;
@@ -56,13 +46,17 @@ GrpcServer::~GrpcServer() { shutdown(); }
 
 Result<std::unique_ptr<GrpcServer>> GrpcServer::start(const ServerConfig& config) {
   auto internals = std::make_unique<Internals>();
-  if (!config.listen_address.empty() && config.token_file.empty() && !config.insecure_listen_any &&
-      !is_loopback_address(config.listen_address))
+  const bool off_loopback = !config.listen_address.empty() && !net::is_loopback_address(config.listen_address);
+  if (off_loopback && config.token_file.empty() && !config.insecure_listen_any)
     return fail("refusing to listen on '" + config.listen_address +
                 "' without --token-file (anyone could submit jobs); use a loopback address, a token file, or "
                 "--insecure-listen-any");
   if (config.tls_cert_file.empty() != config.tls_key_file.empty())
     return fail("TLS needs both --tls-cert and --tls-key");
+  if (off_loopback && !config.token_file.empty() && config.tls_cert_file.empty() && !config.insecure_plaintext_tokens)
+    return fail("refusing to accept tokens over plaintext gRPC on '" + config.listen_address +
+                "' (anyone on the network path could read them); give --tls-cert and --tls-key, use a loopback "
+                "address, or --insecure-plaintext-tokens (e.g. behind a proxy that terminates TLS)");
   if (!config.token_file.empty()) {
     Result<service::TokenTable> tokens = service::TokenTable::load(config.token_file);
     if (!tokens) return fail(tokens.error());

@@ -18,16 +18,16 @@ struct ServerConfig {
   std::string tls_cert_file;            ///< PEM certificate chain; with tls_key_file enables TLS
   std::string tls_key_file;             ///< PEM private key
   bool insecure_listen_any = false;     ///< allow a non-loopback address without a token file
+  bool insecure_plaintext_tokens = false;  ///< allow tokens on a non-loopback address without TLS
   int max_message_bytes = 64 << 20;     ///< largest request or response (bytes)
 };
-
-/// Empty if `address` ("host:port", "[v6]:port", "unix:path") only reaches this machine.
-bool is_loopback_address(const std::string& address);
 
 class GrpcServer {
  public:
   /// Opens the store, recovers unfinished jobs, starts workers and the server. Errors name the problem
-  /// (bad flags, unreadable token file or certificate, store that cannot be opened, port in use).
+  /// (bad flags, unreadable token file or certificate, store that cannot be opened, port in use). A
+  /// non-loopback address needs a token file (or insecure_listen_any), and tokens off loopback need TLS
+  /// (or insecure_plaintext_tokens).
   static Result<std::unique_ptr<GrpcServer>> start(const ServerConfig& config);
   ~GrpcServer();
 

@@ -9,6 +9,9 @@ inline constexpr const char* LOCAL_TENANT = "local";
 
 struct Caller {
   std::string tenant = LOCAL_TENANT;  ///< never the token itself
+  /// May submit jobs with priority above 0: the single user of a server without a token file, or a tenant
+  /// marked `raise-priority` in the token file.
+  bool may_raise_priority = false;
 };
 
 }  // namespace balloon::service

@@ -337,6 +337,9 @@ ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobReques
   }
   if (spec.priority() < -100 || spec.priority() > 100)
     return ServiceStatus::error(StatusCode::InvalidArgument, "priority must be within -100..100");
+  if (spec.priority() > 0 && !caller.may_raise_priority)
+    return ServiceStatus::error(StatusCode::PermissionDenied,
+                                "priority above 0 is only for tenants marked 'raise-priority' in the token file");
   if (!std::isfinite(spec.time_limit_s()) || spec.time_limit_s() < 0.0)
     return ServiceStatus::error(StatusCode::InvalidArgument, "time_limit_s must be a finite number >= 0 (s)");
 
@@ -774,9 +777,7 @@ void JobHandler::run_design_job(const store::JobRecord& record, const v1::JobSpe
   result.inflated_mesh = store::encode_mesh_blob(TriMesh{outcome.result.inflated, outcome.result.rest.faces});
   result.report_json = outcome.report_json;
   if (!m_jobs.mark_completed(record.row_id, result)) return;  // cancelled as it finished: that already published
-  char errors[128];
-  std::snprintf(errors, sizeof(errors), "avg error %.3g mm (%.2g%% of %.3g mm)", outcome.result.avg_error_mm,
-                100.0 * outcome.result.avg_error_rel, outcome.result.bbox_diag_mm);
+  const std::string errors = jobs::design_error_summary(outcome.result);
   const std::string message = (outcome.result.converged ? "completed: converged in " : "completed without converging in ") +
                               format_number(outcome.result.time_s) + " s, " + errors +
                               (outcome.result.converged ? std::string() : ": " + outcome.result.message);

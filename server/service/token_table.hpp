@@ -7,26 +7,30 @@
 #include <vector>
 
 #include "result.hpp"
+#include "service/caller.hpp"
 
 namespace balloon::service {
 
 class TokenTable {
  public:
-  /// Reads a token file: one token per line, `TENANT TOKEN` or just `TOKEN` (the tenant is then
-  /// "tenant-<line number>"); blank lines and lines starting with '#' are skipped. Tokens must be at
-  /// least 16 characters. Errors name the line, never the token.
+  /// Reads a token file: one token per line, `TENANT TOKEN [raise-priority]` or just `TOKEN` (the tenant
+  /// is then "tenant-<line number>"); blank lines and lines starting with '#' are skipped. Tokens must be
+  /// at least 16 characters; a token or a tenant that appears twice is refused (two tenants sharing a
+  /// token would see each other's jobs). `raise-priority` lets the tenant submit jobs with priority above
+  /// 0. Errors name the line, never the token.
   static Result<TokenTable> load(const std::string& path);
-  /// A table from (tenant, token) pairs (tests).
+  /// A table from (tenant, token) pairs (tests); no tenant may raise priority.
   static TokenTable from_pairs(std::vector<std::pair<std::string, std::string>> pairs);
 
-  /// The tenant whose token equals `presented`, checking every token without early exit.
-  std::optional<std::string> tenant_for(std::string_view presented) const;
+  /// The caller whose token equals `presented`, checking every token without early exit.
+  std::optional<Caller> caller_for(std::string_view presented) const;
   std::size_t size() const { return m_entries.size(); }
 
  private:
   struct Entry {
     std::string tenant;
     std::string token;
+    bool may_raise_priority = false;
   };
   std::vector<Entry> m_entries;
 };

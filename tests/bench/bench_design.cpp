@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -184,11 +186,16 @@ int main(int argc, char** argv) {
       options.max_time_s = max_time_s;
       runs.push_back({shape.name, balloon::design_balloon(target->mesh, options)});
       const balloon::DesignResult& r = runs.back().result;
-      std::printf("%-6s %-8s %8d %9.2f %6d %11.4g %11.4g %9.3f %12.4g %12.4g %8.1fx  %s\n", shape.name,
+      // A value that was never computed prints as nan, never as 0.
+      const auto shown = [](const std::optional<double>& value) {
+        return value.value_or(std::numeric_limits<double>::quiet_NaN());
+      };
+      std::printf("%-6s %-8s %8d %9.2f %6d %11.4g %11.4g %9.3f %12.4g %12.4g %8.1fx  %s: %s\n", shape.name,
                   balloon::design_method_name(method).c_str(), r.rest.vertex_count(), r.time_s, r.iterations,
-                  r.avg_error_mm, r.max_error_mm, 100.0 * r.avg_error_rel, r.baseline_avg_error_mm,
-                  r.baseline_max_error_mm, r.avg_error_mm > 0 ? r.baseline_avg_error_mm / r.avg_error_mm : 0.0,
-                  r.converged ? "converged" : r.message.c_str());
+                  shown(r.avg_error_mm), shown(r.max_error_mm), 100.0 * shown(r.avg_error_rel),
+                  shown(r.baseline_avg_error_mm), shown(r.baseline_max_error_mm),
+                  shown(r.baseline_avg_error_mm) / shown(r.avg_error_mm), balloon::design_stop_name(r.stop).c_str(),
+                  r.message.c_str());
       std::fflush(stdout);
       const std::string csv_path =
           out_dir + "/" + shape.name + "_" + balloon::design_method_name(method) + "_convergence.csv";

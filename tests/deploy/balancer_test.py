@@ -53,8 +53,9 @@ def free_port():
 class Shard:
     """One balloon-server: gRPC and HTTP on fixed loopback ports (the balancer's config names them)."""
 
-    def __init__(self, name, server, scratch, tokens):
+    def __init__(self, name, server, scratch, tokens, public_origin):
         self.name, self.server, self.scratch, self.tokens = name, server, scratch, tokens
+        self.public_origin = public_origin  # the balancer's address: the Host the page's requests carry
         self.grpc_port, self.http_port = free_port(), free_port()
         self.db = os.path.join(scratch, f"{name}.db")
         self.process = None
@@ -68,7 +69,8 @@ class Shard:
         self.process = subprocess.Popen(
             [self.server, "--listen", self.grpc, "--http", f"127.0.0.1:{self.http_port}", "--db", self.db,
              "--shard-name", self.name, "--token-file", self.tokens, "--workers", "1",
-             "--drain-timeout", str(DRAIN_TIMEOUT_S), "--web-root", self.scratch],
+             "--drain-timeout", str(DRAIN_TIMEOUT_S), "--web-root", self.scratch,
+             "--http-allowed-origin", self.public_origin],
             stdout=subprocess.PIPE, stderr=log, text=True)
         # Both lines come in one write once the server listens; a server that fails closes its stdout.
         output = ""
@@ -87,8 +89,8 @@ class Shard:
 
 
 class Balancer:
-    def __init__(self, config, scratch, shards):
-        self.grpc_port, self.http_port, self.stats_port = free_port(), free_port(), free_port()
+    def __init__(self, config, scratch, shards, http_port):
+        self.grpc_port, self.http_port, self.stats_port = free_port(), http_port, free_port()
         env = dict(os.environ, BALLOON_LB_GRPC_BIND=f"127.0.0.1:{self.grpc_port}",
                    BALLOON_LB_HTTP_BIND=f"127.0.0.1:{self.http_port}",
                    BALLOON_LB_STATS_BIND=f"127.0.0.1:{self.stats_port}")
@@ -204,20 +206,22 @@ def main():
     with open(tokens, "w") as f:
         f.writelines(f"{tenant} {TOKENS[tenant]}\n" for tenant in TENANTS)
     cli = Cli(options.cli)
-    small, large, huge = (os.path.join(scratch, f"{size}.obj") for size in ("small", "large", "huge"))
-    for path, subdivisions in ((small, 2), (large, 4), (huge, 5)):
+    small, large = (os.path.join(scratch, f"{size}.obj") for size in ("small", "large"))
+    for path, subdivisions in ((small, 2), (large, 4)):
         made = subprocess.run([options.cli, "mesh", "sphere", "--radius", "10", "--subdivisions", str(subdivisions),
                                "--out", path], capture_output=True, text=True)
         check(made.returncode == 0, made.stderr)
 
-    shards = [Shard(name, options.server, scratch, tokens) for name in SHARDS]
+    balancer_http_port = free_port()
+    shards = [Shard(name, options.server, scratch, tokens, f"http://127.0.0.1:{balancer_http_port}")
+              for name in SHARDS]
     for shard in shards:
         shard.start()
-    balancer = Balancer(options.config, scratch, shards)
+    balancer = Balancer(options.config, scratch, shards, balancer_http_port)
     try:
         for i in range(len(shards)):
             balancer.wait_for(f"shard{i}", "UP")
-        submitted = run_scenario(cli, shards, balancer, small, large, huge, scratch)
+        submitted = run_scenario(cli, shards, balancer, small, large, scratch)
         if options.measure:
             submitted.update(measure(cli, shards, balancer, small))
     finally:
@@ -244,7 +248,7 @@ def main():
     return 0
 
 
-def run_scenario(cli, shards, balancer, small, large, huge, scratch):
+def run_scenario(cli, shards, balancer, small, large, scratch):
     """Returns {job_id: tenant} for every job submitted."""
     lb = balancer.grpc
     by_name = {shard.name: shard for shard in shards}
@@ -331,8 +335,17 @@ def run_scenario(cli, shards, balancer, small, large, huge, scratch):
     seen, watch_done = [], threading.Event()
     threading.Thread(target=health_watch, args=(drained.grpc, seen, watch_done), daemon=True).start()
     wait_until(lambda: seen == [1], 10, "the health watch to report SERVING")
-    # Large enough to be still running when SIGTERM arrives, even on an idle machine.
-    drained_job = cli.json(["submit", huge, "--material", "latex", "--volume-ratio", "125"], drained_tenant, lb)["id"]
+    # A design bounded by its own 15 s budget: still running when SIGTERM arrives however fast the solver
+    # gets (a simulation of any size can finish first), and it ends in bounded time after the restart.
+    spot = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "meshes", "spot.obj")
+    with open(spot, "rb") as f:
+        design = {"spec": {"design": {"target_mesh": {"data": base64.b64encode(f.read()).decode(),
+                                                      "format": "MESH_FORMAT_OBJ"},
+                                      "material": {"name": "silicone"}, "size_mm": 100, "resolution": 1500,
+                                      "max_time_s": 15}}}
+    with http_request(f"http://127.0.0.1:{balancer.http_port}/api/v1/jobs", TOKENS[drained_tenant],
+                      json.dumps(design).encode()) as reply:
+        drained_job = json.loads(reply.read())["job"]["id"]
     submitted[drained_job] = drained_tenant
     wait_until(lambda: cli.json(["jobs", "show", drained_job], drained_tenant, lb)["state"] == "JOB_STATE_RUNNING", 30,
                "the job to drain to run")
@@ -348,7 +361,8 @@ def run_scenario(cli, shards, balancer, small, large, huge, scratch):
     drained.start()
     balancer.wait_for(f"shard{index}", "UP")
     watched = cli.run(["jobs", "watch", drained_job], drained_tenant, lb)
-    check(watched.returncode == 0, f"the drained job: exit {watched.returncode}: {watched.stderr[-400:]}")
+    # Exit 3: the design ran to its time budget, honestly not converged; it finished all the same.
+    check(watched.returncode in (0, 3), f"the drained job: exit {watched.returncode}: {watched.stderr[-400:]}")
     attempts = cli.json(["jobs", "show", drained_job], drained_tenant, lb)["attempts"]
     check(attempts == 2, f"the drained job ran {attempts} time(s), 2 expected (interrupted, then again)")
 

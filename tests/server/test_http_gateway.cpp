@@ -21,12 +21,14 @@
 
 #include "balloon/v1/balloon.grpc.pb.h"
 #include "http/json_mapping.hpp"
+#include "http/origin_policy.hpp"
 #include "http/static_files.hpp"
 #include "jobs/design_job.hpp"
 #include "jobs/fit_job.hpp"
 #include "jobs/json_reader.hpp"
 #include "mesh/icosphere.hpp"
 #include "mesh/mesh_io.hpp"
+#include "net/network_address.hpp"
 #include "scratch_dir.hpp"
 #include "server_process.hpp"
 
@@ -237,6 +239,54 @@ TEST(HttpGateway, MoldFromReportNamesWhyThereIsNoMold) {
       jobs::mold_from_report(rest, R"({"mold":{"nozzle_vertex":0,"tube_radius_mm":1.5,"tube_length_mm":4}})");
   ASSERT_TRUE(mold.ok()) << mold.error();
   EXPECT_GT(mold->vertex_count(), rest.vertex_count());
+}
+
+TEST(HttpGateway, LoopbackTestParsesTheAddress) {
+  for (const char* host : {"localhost", "LocalHost", "127.0.0.1", "127.255.255.254", "127.0.1.1", "::1",
+                           "0:0:0:0:0:0:0:1", "::ffff:127.0.0.1"})
+    EXPECT_TRUE(net::is_loopback_host(host)) << host;
+  for (const char* host : {"127.evil.example", "127.0.0.1.evil.example", "127.1", "0x7f.0.0.1", "0177.0.0.1",
+                           "128.0.0.1", "10.0.0.1", "0.0.0.0", "::", "::2", "localhost.evil.example",
+                           "evil.example", "", " 127.0.0.1", "127.0.0.1 "})
+    EXPECT_FALSE(net::is_loopback_host(host)) << "'" << host << "'";
+  for (const char* address : {"127.0.0.1:50051", "127.0.0.1:0", "[::1]:8080", "localhost:1", "unix:/tmp/balloon.sock"})
+    EXPECT_TRUE(net::is_loopback_address(address)) << address;
+  for (const char* address : {"127.evil.example:50051", "0.0.0.0:50051", "[::]:50051", "127.0.0.1", ":50051",
+                              "127.0.0.1:port", "[::1]", "::1:50051", "192.168.1.10:80"})
+    EXPECT_FALSE(net::is_loopback_address(address)) << address;
+}
+
+TEST(HttpGateway, OriginPolicyServesLoopbackAndAllowedOriginsOnly) {
+  const Result<http::WebOrigin> allowed = http::parse_origin("HTTPS://Balloon.Example/");
+  ASSERT_TRUE(allowed.ok()) << allowed.error();
+  EXPECT_EQ(allowed->scheme, "https");
+  EXPECT_EQ(allowed->host, "balloon.example");
+  EXPECT_EQ(allowed->port, 443);
+  for (const char* bad : {"balloon.example", "ftp://balloon.example", "https://balloon.example/app",
+                          "https://user@balloon.example", "https://balloon.example:99999", "https://", "null",
+                          "https://[::1", "https://a b"})
+    EXPECT_FALSE(http::parse_origin(bad).ok()) << bad;
+
+  const http::OriginPolicy policy(/*tls=*/false, 8080, {*allowed});
+  const auto refused = [&](const char* host, const char* origin) {
+    const std::string host_text = host == nullptr ? "" : host, origin_text = origin == nullptr ? "" : origin;
+    return !policy.refusal(host == nullptr ? nullptr : &host_text, origin == nullptr ? nullptr : &origin_text).empty();
+  };
+  // Scripts and curl: no Origin, a loopback Host with this port.
+  for (const char* host : {"127.0.0.1:8080", "localhost:8080", "[::1]:8080", "127.0.0.2:8080", "balloon.example"})
+    EXPECT_FALSE(refused(host, nullptr)) << host;
+  // DNS rebinding and look-alikes.
+  for (const char* host : {"evil.example:8080", "evil.example", "127.evil.example:8080", "127.0.0.1:8081",
+                           "127.0.0.1", "localhost", "127.0.0.1:8080:1", "[::1", ""})
+    EXPECT_TRUE(refused(host, nullptr)) << host;
+  EXPECT_TRUE(refused(nullptr, nullptr)) << "no Host header";
+  // The page itself, on any loopback name, and the allowed origin.
+  for (const char* origin : {"http://127.0.0.1:8080", "http://localhost:8080", "http://[::1]:8080", "https://balloon.example",
+                             "https://balloon.example:443"})
+    EXPECT_FALSE(refused("127.0.0.1:8080", origin)) << origin;
+  for (const char* origin : {"http://evil.example", "https://127.0.0.1:8080", "http://127.0.0.1:3000", "null",
+                             "http://balloon.example", "https://balloon.example:8443", "http://127.evil.example:8080", ""})
+    EXPECT_TRUE(refused("127.0.0.1:8080", origin)) << origin;
 }
 
 // --- a real server ----------------------------------------------------------------------------------
@@ -686,6 +736,306 @@ TEST(HttpGateway, FlagsFollowTheLoopbackRuleAndAreDocumented) {
   output.clear();
   EXPECT_EQ(run_server({"--listen", "127.0.0.1:0", "--db", ":memory:", "--http", "127.0.0.1:http"}, &output), 1);
   EXPECT_NE(output.find("port 'http'"), std::string::npos) << output;
+}
+
+// --- what a browser on another site can make it do (README.md, "Security") -------------------------------
+
+/// The number of jobs the caller sees.
+int job_count(httplib::Client& client) {
+  const auto listed = client.Get("/api/v1/jobs");
+  if (!listed || listed->status != 200) return -1;
+  return parse<v1::ListJobsResponse>(listed->body).jobs_size();
+}
+
+TEST(HttpGateway, CrossSiteRequestsAndDnsRebindingAreRefused) {
+  ScratchDir scratch;
+  HttpServer server(scratch, {"--quiet", "--workers", "1"});
+  auto client = server.client();
+  const std::string own = "127.0.0.1:" + std::to_string(server.http_port());
+  const std::string body = simulate_body(sphere_obj(1), R"("volume_ratio":2)");
+
+  // CSRF: a form or fetch with `text/plain` goes cross-site without a preflight. Refused before the service.
+  auto multipart = client->Post("/api/v1/jobs", body.substr(0, 4000), "multipart/form-data; boundary=x");
+  ASSERT_TRUE(multipart);
+  EXPECT_EQ(multipart->status, 400) << "httplib refuses the malformed form itself";
+  for (const char* type : {"text/plain", "application/x-www-form-urlencoded", "application/jsonx", "text/json"}) {
+    auto posted = client->Post("/api/v1/jobs", body.substr(0, 4000), type);
+    ASSERT_TRUE(posted) << type;
+    EXPECT_EQ(posted->status, 415) << type;
+    EXPECT_EQ(error_of(posted).first, "INVALID_ARGUMENT") << type;
+    EXPECT_NE(error_of(posted).second.find("Content-Type: application/json"), std::string::npos) << error_of(posted).second;
+  }
+  auto untyped = client->Post("/api/v1/jobs", httplib::Headers{}, body, "");
+  ASSERT_TRUE(untyped);
+  EXPECT_EQ(untyped->status, 415) << "a body without a Content-Type";
+  auto put = client->Put("/api/v1/materials/soft", R"({"spec":"neo-hookean:mu=0.25"})", "text/plain");
+  ASSERT_TRUE(put);
+  EXPECT_EQ(put->status, 415);
+
+  // A page on another site, even with the right Content-Type (the browser sends its Origin).
+  for (const char* origin : {"http://evil.example", "null", "http://localhost:1", "http://127.0.0.1:1"}) {
+    auto posted = client->Post("/api/v1/jobs", {{"Origin", origin}}, body, "application/json");
+    ASSERT_TRUE(posted) << origin;
+    EXPECT_EQ(posted->status, 403) << origin;
+    EXPECT_EQ(error_of(posted).first, "PERMISSION_DENIED") << origin;
+    EXPECT_NE(error_of(posted).second.find("cross-origin"), std::string::npos) << error_of(posted).second;
+  }
+  EXPECT_EQ(job_count(*client), 0) << "no refused request may create a job";
+
+  // DNS rebinding: another name pointed at 127.0.0.1 reaches the port, with that name as Host.
+  for (const std::string& host : {std::string("evil.example"), "evil.example:" + std::to_string(server.http_port()),
+                                 "127.evil.example:" + std::to_string(server.http_port()), std::string("127.0.0.1:1")}) {
+    // (/api/v1/health answers any Host: probes call it by address, and it reveals nothing.)
+    for (const char* path : {"/api/v1/jobs", "/api/v1/materials", "/"}) {
+      auto got = client->Get(path, {{"Host", host}});
+      ASSERT_TRUE(got) << host << path;
+      EXPECT_EQ(got->status, 403) << host << path;
+      EXPECT_EQ(got->body.find("\"jobs\""), std::string::npos) << host << path;
+    }
+  }
+
+  // The page itself (its own origin, on any loopback name) and scripts without an Origin still work.
+  const std::string job = submit(*client, body, {{"Origin", "http://" + own}});
+  ASSERT_FALSE(job.empty());
+  EXPECT_FALSE(submit(*client, body).empty()) << "curl-like: no Origin";
+  EXPECT_FALSE(submit(*client, body, {{"Host", "localhost:" + std::to_string(server.http_port())},
+                                      {"Origin", "http://localhost:" + std::to_string(server.http_port())}})
+                   .empty());
+  auto cancelled = client->Post("/api/v1/jobs/" + job + "/cancel");  // curl -X POST: no body, no type
+  ASSERT_TRUE(cancelled);
+  EXPECT_EQ(cancelled->status, 200) << cancelled->body;
+  auto charset = client->Put("/api/v1/materials/soft", R"({"spec":"neo-hookean:mu=0.25"})",
+                             "Application/JSON; charset=utf-8");
+  ASSERT_TRUE(charset);
+  EXPECT_EQ(charset->status, 200) << charset->body;
+  EXPECT_EQ(job_count(*client), 3);
+}
+
+TEST(HttpGateway, AllowedOriginFlagAdmitsThatPageOnly) {
+  ScratchDir scratch;
+  HttpServer server(scratch, {"--quiet", "--workers", "1", "--http-allowed-origin", "https://balloon.example",
+                              "--http-allowed-origin", "http://lab.example:8000"});
+  auto client = server.client();
+  const std::string body = R"({"spec":"neo-hookean:mu=0.25"})";
+  // As behind a proxy that forwards the public name: Host is the allowed origin's host.
+  for (const auto& [host, origin] : std::vector<std::pair<std::string, std::string>>{
+           {"balloon.example", "https://balloon.example"},
+           {"lab.example:8000", "http://lab.example:8000"},
+           {"127.0.0.1:" + std::to_string(server.http_port()), "https://balloon.example"}}) {
+    auto put = client->Put("/api/v1/materials/soft", {{"Host", host}, {"Origin", origin}}, body, "application/json");
+    ASSERT_TRUE(put) << origin;
+    EXPECT_EQ(put->status, 200) << host << " " << origin << ": " << put->body;
+  }
+  for (const auto& [host, origin] : std::vector<std::pair<std::string, std::string>>{
+           {"balloon.example", "http://balloon.example"},        // another scheme is another origin
+           {"balloon.example", "https://balloon.example:8443"},  // and another port
+           {"balloon.example", "https://evil.example"},
+           {"evil.example", "https://balloon.example"}}) {
+    auto put = client->Put("/api/v1/materials/soft", {{"Host", host}, {"Origin", origin}}, body, "application/json");
+    ASSERT_TRUE(put) << origin;
+    EXPECT_EQ(put->status, 403) << host << " " << origin;
+  }
+  std::string output;
+  EXPECT_EQ(run_server({"--http", "127.0.0.1:0", "--db", ":memory:", "--http-allowed-origin", "balloon.example"}, &output), 2);
+  EXPECT_NE(output.find("--http-allowed-origin"), std::string::npos) << output;
+  EXPECT_NE(output.find("SCHEME://HOST[:PORT]"), std::string::npos) << output;
+}
+
+// An open event stream holds one worker thread; the pool has --http-max-event-streams more threads than it
+// needs for the rest, and streams past that number get 503, so /health never waits behind streams.
+TEST(HttpGateway, ThirtyTwoOpenEventStreamsLeaveHealthAnswering) {
+  constexpr int HELD = 32, CAP = 34;
+  ScratchDir scratch;
+  HttpServer server(scratch, {"--quiet", "--workers", "1", "--http-max-event-streams", std::to_string(CAP)});
+  auto client = server.client();
+  const std::string busy = submit(*client, busy_job_body());
+  const std::string queued = submit(*client, simulate_body(sphere_obj(1), R"("volume_ratio":2)"));
+  ASSERT_FALSE(busy.empty());
+  ASSERT_FALSE(queued.empty());
+  const std::string path = "/api/v1/jobs/" + queued + "/events";
+
+  struct HeldStream {
+    std::atomic<bool> opened{false};
+    std::atomic<bool> done{false};  ///< the request returned (a 503, or the stream's end)
+    std::string body;
+    std::thread reader;
+  };
+  std::vector<std::unique_ptr<HeldStream>> held;
+  const auto hold_one = [&] {
+    auto stream = std::make_unique<HeldStream>();
+    HeldStream* raw = stream.get();
+    raw->reader = std::thread([&server, raw, path] {
+      auto tab = server.client();
+      tab->Get(path, [raw](const char* data, size_t length) {
+        raw->body.append(data, length);
+        if (raw->body.find("event: job") != std::string::npos) raw->opened = true;
+        return true;
+      });
+      raw->done = true;
+    });
+    held.push_back(std::move(stream));
+  };
+  const auto wait_opened = [&] {
+    const auto deadline = Clock::now() + std::chrono::seconds(30);
+    for (const auto& stream : held)
+      while (!stream->opened && !stream->done && Clock::now() < deadline)
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    int opened = 0;
+    for (const auto& stream : held) opened += stream->opened ? 1 : 0;
+    return opened;
+  };
+  for (int i = 0; i < HELD; ++i) hold_one();
+  ASSERT_EQ(wait_opened(), HELD);
+
+  auto health = client->Get("/api/v1/health");
+  ASSERT_TRUE(health) << "no worker thread left with " << HELD << " open streams";
+  EXPECT_EQ(health->status, 200);
+  auto job = client->Get("/api/v1/jobs/" + queued);
+  ASSERT_TRUE(job);
+  EXPECT_EQ(parse<v1::Job>(job->body).state(), v1::JOB_STATE_QUEUED) << "the streams need a quiet job";
+
+  // Streams that hang up give their place back: more of them than the places left, one after another.
+  for (int i = 0; i < 6; ++i) {
+    bool got_first = false;
+    const auto deadline = Clock::now() + std::chrono::seconds(10);
+    while (!got_first && Clock::now() < deadline) {
+      auto tab = server.client();
+      tab->Get(path, [&](const char* data, size_t length) {
+        got_first = std::string(data, length).find("event: job") != std::string::npos;
+        return !got_first;
+      });
+      if (!got_first) std::this_thread::sleep_for(std::chrono::milliseconds(20));  // a 503 until one comes back
+    }
+    EXPECT_TRUE(got_first) << "stream " << i << " never found a free place";
+  }
+  for (int i = HELD; i < CAP; ++i) {
+    const auto deadline = Clock::now() + std::chrono::seconds(10);
+    // The hung-up streams above may still hold their places for one poll (0.25 s).
+    while (Clock::now() < deadline) {
+      hold_one();
+      if (wait_opened() == static_cast<int>(held.size())) break;
+      held.back()->reader.join();  // it got 503: the server answered and the reader returned
+      held.pop_back();
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  }
+  ASSERT_EQ(wait_opened(), CAP);
+  auto refused = client->Get(path);
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 503);
+  EXPECT_EQ(error_of(refused).first, "UNAVAILABLE");
+  EXPECT_NE(error_of(refused).second.find("--http-max-event-streams"), std::string::npos) << error_of(refused).second;
+  health = client->Get("/api/v1/health");
+  ASSERT_TRUE(health);
+  EXPECT_EQ(health->status, 200);
+
+  EXPECT_EQ(server.stop(SIGTERM), 0);  // ends every stream with `event: end`
+  for (const auto& stream : held) {
+    stream->reader.join();
+    EXPECT_NE(stream->body.find("event: end"), std::string::npos);
+  }
+}
+
+TEST(HttpGateway, ServesHttpsWithTheGivenCertificate) {
+  ScratchDir scratch;
+  const std::string cert = scratch.file("cert.pem"), key = scratch.file("key.pem");
+  const std::string openssl = "openssl req -x509 -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes -days 2 "
+                              "-subj /CN=localhost -addext subjectAltName=IP:127.0.0.1,DNS:localhost -keyout '" +
+                              key + "' -out '" + cert + "' >/dev/null 2>&1";
+  if (std::system(openssl.c_str()) != 0) GTEST_SKIP() << "openssl cannot make a test certificate";
+  HttpServer server(scratch, {"--quiet", "--workers", "1", "--http-tls-cert", cert, "--http-tls-key", key});
+  EXPECT_NE(server.output().find("(https, web root"), std::string::npos) << server.output();
+  httplib::SSLClient secure("127.0.0.1", server.http_port());
+  secure.set_ca_cert_path(cert.c_str());
+  secure.enable_server_certificate_verification(true);
+  secure.set_read_timeout(30, 0);
+  auto health = secure.Get("/api/v1/health");
+  ASSERT_TRUE(health) << httplib::to_string(health.error());
+  EXPECT_EQ(health->status, 200);
+  EXPECT_EQ(health->body, R"({"status":"ok"})");
+  const std::string origin = "https://127.0.0.1:" + std::to_string(server.http_port());
+  auto put = secure.Put("/api/v1/materials/soft", {{"Origin", origin}}, R"({"spec":"neo-hookean:mu=0.25"})",
+                        "application/json");
+  ASSERT_TRUE(put);
+  EXPECT_EQ(put->status, 200) << put->body;
+  auto plain_origin = secure.Put("/api/v1/materials/soft", {{"Origin", "http://127.0.0.1:" + std::to_string(server.http_port())}},
+                                 R"({"spec":"neo-hookean:mu=0.25"})", "application/json");
+  ASSERT_TRUE(plain_origin);
+  EXPECT_EQ(plain_origin->status, 403) << "the http:// page is another origin than the https:// server";
+  auto plaintext = server.client()->Get("/api/v1/health");
+  EXPECT_TRUE(!plaintext || plaintext->status != 200) << "plain HTTP must not be answered on the HTTPS port";
+
+  std::string output;
+  EXPECT_EQ(run_server({"--http", "127.0.0.1:0", "--db", ":memory:", "--http-tls-cert", cert}, &output), 2);
+  EXPECT_NE(output.find("--http-tls-key"), std::string::npos) << output;
+  output.clear();
+  EXPECT_EQ(run_server({"--http", "127.0.0.1:0", "--db", ":memory:", "--http-tls-cert", key, "--http-tls-key", cert},
+                       &output), 1);
+  EXPECT_NE(output.find("HTTP TLS"), std::string::npos) << output;
+}
+
+TEST(HttpGateway, TokensAreRefusedOverPlaintextOffLoopbackAndMustBeUnique) {
+  ScratchDir scratch;
+  const std::string tokens = scratch.file("tokens");
+  std::ofstream(tokens) << "alice alice-token-0123456789\nbob bob-token-0123456789ab\n";
+  // A store that cannot open ends the start after every flag rule has passed (exit 1, naming the store).
+  const std::string no_store = scratch.file("no-such-dir") + "/jobs.db";
+  std::string output;
+  EXPECT_EQ(run_server({"--listen", "0.0.0.0:0", "--token-file", tokens, "--db", no_store}, &output), 1);
+  EXPECT_NE(output.find("plaintext gRPC"), std::string::npos) << output;
+  EXPECT_NE(output.find("--insecure-plaintext-tokens"), std::string::npos) << output;
+  output.clear();
+  EXPECT_EQ(run_server({"--listen", "0.0.0.0:0", "--token-file", tokens, "--db", no_store, "--insecure-plaintext-tokens"},
+                       &output), 1);
+  EXPECT_EQ(output.find("plaintext"), std::string::npos) << output;
+  output.clear();
+  EXPECT_EQ(run_server({"--listen", "127.0.0.1:0", "--http", "0.0.0.0:0", "--token-file", tokens, "--db", no_store},
+                       &output), 2);
+  EXPECT_NE(output.find("plaintext HTTP"), std::string::npos) << output;
+  EXPECT_NE(output.find("--insecure-plaintext-tokens"), std::string::npos) << output;
+  output.clear();
+  EXPECT_EQ(run_server({"--listen", "127.0.0.1:0", "--http", "0.0.0.0:0", "--token-file", tokens, "--db", no_store,
+                        "--http-tls-cert", tokens, "--http-tls-key", tokens},
+                       &output), 1);
+  EXPECT_EQ(output.find("plaintext"), std::string::npos) << output;
+  // A name that only looks like loopback is not.
+  output.clear();
+  EXPECT_EQ(run_server({"--listen", "127.evil.example:0", "--db", ":memory:"}, &output), 1);
+  EXPECT_NE(output.find("without --token-file"), std::string::npos) << output;
+
+  // A repeated token would merge two tenants: refused at start, naming the lines, never the token.
+  std::ofstream(scratch.file("twice")) << "alice shared-token-0123456789\n# comment\nbob shared-token-0123456789\n";
+  output.clear();
+  EXPECT_EQ(run_server({"--token-file", scratch.file("twice"), "--db", ":memory:"}, &output), 1);
+  EXPECT_NE(output.find("line 3: the same token as line 1"), std::string::npos) << output;
+  EXPECT_EQ(output.find("shared-token"), std::string::npos) << "tokens must never be printed: " << output;
+  std::ofstream(scratch.file("bad-option")) << "alice alice-token-0123456789 second-token-0123456789\n";
+  output.clear();
+  EXPECT_EQ(run_server({"--token-file", scratch.file("bad-option"), "--db", ":memory:"}, &output), 1);
+  EXPECT_NE(output.find("line 1: only 'raise-priority'"), std::string::npos) << output;
+  EXPECT_EQ(output.find("second-token"), std::string::npos) << output;
+}
+
+TEST(HttpGateway, OnlyMarkedTenantsRaisePriority) {
+  ScratchDir scratch;
+  std::ofstream(scratch.file("tokens")) << "boss boss-token-0123456789 raise-priority\nbob bob-token-0123456789ab\n";
+  HttpServer server(scratch, {"--quiet", "--workers", "1", "--token-file", scratch.file("tokens")});
+  auto client = server.client();
+  const httplib::Headers boss = {{"Authorization", "Bearer boss-token-0123456789"}};
+  const httplib::Headers bob = {{"Authorization", "Bearer bob-token-0123456789ab"}};
+  const auto with_priority = [](int priority) {
+    std::string body = simulate_body(sphere_obj(1), R"("volume_ratio":2)");
+    body.insert(body.size() - 2, ",\"priority\":" + std::to_string(priority));
+    return body;
+  };
+  auto raised = client->Post("/api/v1/jobs", bob, with_priority(5), "application/json");
+  ASSERT_TRUE(raised);
+  EXPECT_EQ(raised->status, 403) << raised->body;
+  EXPECT_EQ(error_of(raised).first, "PERMISSION_DENIED");
+  EXPECT_NE(error_of(raised).second.find("raise-priority"), std::string::npos) << error_of(raised).second;
+  EXPECT_FALSE(submit(*client, with_priority(0), bob).empty());
+  EXPECT_FALSE(submit(*client, with_priority(-5), bob).empty());
+  EXPECT_FALSE(submit(*client, with_priority(5), boss).empty());
 }
 
 }  // namespace

@@ -12,6 +12,7 @@ import { mesh_format_for } from '../../client/web/src/mesh_loader.js';
 import { ordered_params, param_label } from '../../client/web/src/material_params.js';
 import { SurfaceDistance } from '../../client/web/src/surface_distance.js';
 import { base64_from_bytes, bytes_from_base64 } from '../../client/web/src/api_client.js';
+import { format_error_mm } from '../../client/web/src/format.js';
 
 test('SSE parser: events split across chunks, CRLF, comments and multi-line data', () => {
   const parser = new SseParser();
@@ -123,4 +124,12 @@ test('base64 round trip of bytes, including large buffers', () => {
   assert.equal(back.length, bytes.length);
   assert.ok(back.every((value, i) => value === bytes[i]));
   assert.equal(base64_from_bytes(new TextEncoder().encode('OFF\n').buffer), 'T0ZGCg==');
+});
+
+test('an error that was never computed (null) shows as a dash, not 0', () => {
+  assert.equal(format_error_mm(null), '–');
+  assert.equal(format_error_mm(undefined), '–');
+  assert.equal(format_error_mm(-1), '–');
+  assert.notEqual(format_error_mm(0), '–');
+  assert.notEqual(format_error_mm(0.25), '–');
 });

@@ -17,7 +17,8 @@ export function format_number(value, significant = 4) {
 
 /** A distance readout (mm) where -1 means "not applicable". */
 export function format_error_mm(value) {
-  return Number(value) >= 0 ? format_number(value) : '–';
+  // null (never computed) must not read as 0: Number(null) is 0.
+  return value !== null && value !== undefined && Number(value) >= 0 ? format_number(value) : '–';
 }
 
 const STATE_LABELS = {

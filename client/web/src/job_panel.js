@@ -386,8 +386,8 @@ export class JobPanel {
 
   show_summary(job, report) {
     const { readouts, summary } = this.m_elements;
-    if (report.avg_error_mm !== undefined) readouts.avg_error.textContent = format_error_mm(report.avg_error_mm);
-    if (report.max_error_mm !== undefined) readouts.max_error.textContent = format_error_mm(report.max_error_mm);
+    if (report.avg_error_mm != null) readouts.avg_error.textContent = format_error_mm(report.avg_error_mm);
+    if (report.max_error_mm != null) readouts.max_error.textContent = format_error_mm(report.max_error_mm);
     if (report.pressure_kpa !== undefined) readouts.pressure.textContent = format_number(report.pressure_kpa, 4);
     if (report.time_s !== undefined) readouts.elapsed.textContent = format_number(report.time_s, 3);
     if (report.iterations !== undefined) readouts.iteration.textContent = String(report.iterations);
@@ -395,12 +395,15 @@ export class JobPanel {
     const lines = [];
     const converged = report.converged ?? job.converged;
     lines.push(`${kind_label(job.kind)} ${converged ? 'converged' : 'stopped before converging'}` +
+      (report.stop_reason ? ` [${report.stop_reason.replace('_', ' ')}]` : '') +
       (report.message ? ` (${report.message})` : ''));
-    if (report.avg_error_mm !== undefined)
+    if (job.kind === 'JOB_KIND_DESIGN' && report.avg_error_mm == null)
+      lines.push('No design error: the start shape was never inflated, so there is nothing to compare.');
+    if (report.avg_error_mm != null)
       lines.push(`Inflated shape vs target: average ${format_error_mm(report.avg_error_mm)} mm, largest ` +
         `${format_error_mm(report.max_error_mm)} mm, on a ${format_number(report.bbox_diag_mm, 4)} mm bounding-box diagonal ` +
         `(${format_number(100 * report.avg_error_rel, 3)} % / ${format_number(100 * report.max_error_rel, 3)} %).`);
-    if (report.baseline_avg_error_mm !== undefined)
+    if (report.baseline_avg_error_mm != null)
       lines.push(`Just shrinking the target would give an average error of ${format_error_mm(report.baseline_avg_error_mm)} mm.`);
     if (report.pressure_kpa !== undefined)
       lines.push(`Inflate to ${format_number(report.pressure_kpa, 4)} kPa; volume ratio ${format_number(report.volume_ratio, 4)}; ` +

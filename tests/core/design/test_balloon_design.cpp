@@ -37,12 +37,12 @@ TEST(BalloonDesign, RecoversTheBalloonOfAnInflatedEllipsoid) {
   ASSERT_FALSE(design.log.empty()) << design.message;
   EXPECT_TRUE(design.rest.vertices.allFinite());
   // The downscaled target inflates visibly wrong; the design must be far better.
-  EXPECT_GT(design.baseline_avg_error_mm, 10.0 * design.avg_error_mm) << design.message;
-  EXPECT_LT(design.avg_error_rel, 1e-3) << design.message << " after " << design.iterations << " iterations";
+  EXPECT_GT(design.baseline_avg_error_mm.value(), 10.0 * design.avg_error_mm.value()) << design.message;
+  EXPECT_LT(design.avg_error_rel.value(), 1e-3) << design.message << " after " << design.iterations << " iterations";
   EXPECT_NEAR(design.volume_ratio, 6.0, 1e-3);
-  EXPECT_TRUE(design.converged) << design.message;
+  EXPECT_TRUE(design.converged) << design_stop_name(design.stop) << ": " << design.message;
   std::printf("ellipsoid design: %d iterations, %.2f s, avg error %.3g mm (baseline %.3g mm), %s\n", design.iterations,
-              design.time_s, design.avg_error_mm, design.baseline_avg_error_mm, design.message.c_str());
+              design.time_s, design.avg_error_mm.value(), design.baseline_avg_error_mm.value(), design.message.c_str());
 }
 
 /// A target that has an exact answer: a 162-vertex ellipsoid (semi-axes 32, 20, 20 mm) inflated six-fold.
@@ -69,12 +69,12 @@ TEST(BalloonDesign, AugmentedLagrangianRecoversTheBalloonAndEndsInEquilibrium) {
   const DesignResult design = design_balloon(target, options);
   ASSERT_FALSE(design.log.empty()) << design.message;
   EXPECT_EQ(design.method, DesignMethod::AugmentedLagrangian);
-  EXPECT_TRUE(design.converged) << design.message;
-  EXPECT_LT(design.avg_error_rel, 1e-3) << design.message;
+  EXPECT_TRUE(design.converged) << design_stop_name(design.stop) << ": " << design.message;
+  EXPECT_LT(design.avg_error_rel.value(), 1e-3) << design.message;
   // Reported errors are those of a true equilibrium of the designed rest shape.
   EXPECT_LT(design.residual_norm, 1e-6 * design.pressure_kpa * 1e-3 * 4e4) << design.message;
   std::printf("alm ellipsoid: %d iterations, %.2f s, avg error %.3g mm (baseline %.3g mm), %s\n", design.iterations,
-              design.time_s, design.avg_error_mm, design.baseline_avg_error_mm, design.message.c_str());
+              design.time_s, design.avg_error_mm.value(), design.baseline_avg_error_mm.value(), design.message.c_str());
 }
 
 /// Mean distance between corresponding rows (mm).
@@ -111,8 +111,13 @@ TEST(BalloonDesign, APerturbedStartEndsAtTheSameInflatedShape) {
   // re-places it on the target whenever it stalls, which takes a few hundred cheap iterations here.
   options.max_iterations = 1000;
   const DesignResult perturbed = design_balloon(target, options);
-  ASSERT_TRUE(perturbed.converged) << perturbed.message;
-  EXPECT_LT(perturbed.avg_error_rel, 1e-3) << perturbed.message;
+  // It ends by its own criteria (matched, optimal, or an honest stall once the objective stops falling),
+  // not by a budget; what the paper's test asks is the same inflated shape.
+  ASSERT_TRUE(perturbed.stop == DesignStop::Matched || perturbed.stop == DesignStop::Optimal ||
+              perturbed.stop == DesignStop::Stalled)
+      << design_stop_name(perturbed.stop) << ": " << perturbed.message;
+  EXPECT_EQ(perturbed.converged, perturbed.stop != DesignStop::Stalled);
+  EXPECT_LT(perturbed.avg_error_rel.value(), 1e-3) << perturbed.message;
   const double inflated_change = mean_distance(perturbed.inflated, reference.inflated) / reference.bbox_diag_mm;
   EXPECT_LT(inflated_change, 1e-3);
   // Inflation irons out rest-shape bumps (the start inflates to within a fraction of the perturbation), so
@@ -166,7 +171,7 @@ TEST(BalloonDesign, OnlyTheTermsTheSceneNeedsAreActive) {
   EXPECT_TRUE(has("rest_bending"));
   EXPECT_TRUE(has("nozzle"));
   EXPECT_FALSE(has("max_volume"));
-  EXPECT_LE(flat.avg_error_mm, flat.baseline_avg_error_mm) << flat.message;
+  EXPECT_LE(flat.avg_error_mm.value(), flat.baseline_avg_error_mm.value()) << flat.message;
 }
 
 TEST(BalloonDesign, StiffThinAndHighRatioCasesConvergeOrSayWhy) {
@@ -191,15 +196,16 @@ TEST(BalloonDesign, StiffThinAndHighRatioCasesConvergeOrSayWhy) {
     ASSERT_FALSE(design.log.empty()) << scene.name << ": " << design.message;
     EXPECT_TRUE(design.rest.vertices.allFinite()) << scene.name;
     EXPECT_TRUE(design.inflated.allFinite()) << scene.name;
-    EXPECT_TRUE(std::isfinite(design.avg_error_mm) && std::isfinite(design.residual_norm)) << scene.name;
+    ASSERT_TRUE(design.avg_error_mm.has_value()) << scene.name << ": " << design.message;
+    EXPECT_TRUE(std::isfinite(design.avg_error_mm.value()) && std::isfinite(design.residual_norm)) << scene.name;
     if (design.converged) {
-      EXPECT_LT(design.avg_error_mm, 0.5 * design.baseline_avg_error_mm) << scene.name << ": " << design.message;
+      EXPECT_LT(design.avg_error_mm.value(), 0.5 * design.baseline_avg_error_mm.value()) << scene.name << ": " << design.message;
     } else {
       EXPECT_FALSE(design.message.empty()) << scene.name;
     }
     std::printf("%s: %s after %d iterations, %.1f s, avg error %.3g mm (baseline %.3g mm), residual %.2g N\n",
-                scene.name, design.message.c_str(), design.iterations, design.time_s, design.avg_error_mm,
-                design.baseline_avg_error_mm, design.residual_norm);
+                scene.name, design.message.c_str(), design.iterations, design.time_s, design.avg_error_mm.value(),
+                design.baseline_avg_error_mm.value(), design.residual_norm);
   }
 }
 
@@ -210,7 +216,47 @@ TEST(BalloonDesign, BadOptionsAreReportedNotThrown) {
   options.thickness_mm = -1;
   const DesignResult design = design_balloon(target, options);
   EXPECT_FALSE(design.converged);
+  EXPECT_EQ(design.stop, DesignStop::StartFailed);
   EXPECT_NE(design.message.find("thickness"), std::string::npos);
+  EXPECT_FALSE(design.avg_error_mm.has_value());
+  EXPECT_FALSE(design.baseline_avg_error_mm.has_value());
+}
+
+TEST(BalloonDesign, ADesignStoppedBeforeItsStartInflatedHasNoErrors) {
+  // Cancelled before the start was inflated: there is neither a design nor a baseline, so both errors
+  // are empty (JSON null), never 0, and nothing is called converged.
+  const TriMesh target = make_icosphere(20.0, 2);
+  DesignOptions options;
+  options.material = *parse_material_spec("silicone");
+  CancelToken cancel;
+  cancel.cancel();
+  options.cancel = &cancel;
+  const DesignResult design = design_balloon(target, options);
+  EXPECT_FALSE(design.converged);
+  EXPECT_EQ(design.stop, DesignStop::Cancelled) << design.message;
+  EXPECT_TRUE(design.log.empty());
+  EXPECT_FALSE(design.avg_error_mm.has_value()) << "a design never inflated has no error, not 0";
+  EXPECT_FALSE(design.baseline_avg_error_mm.has_value());
+}
+
+TEST(BalloonDesign, AStalledDesignIsNotCalledConverged) {
+  // A box with flat faces and sharp edges: no inflated membrane matches it, so the design improves on
+  // the start, then stops improving. That is a stall, reported as one, never as convergence.
+  TriMesh box = make_icosphere(20.0, 2);
+  box.vertices = box.vertices.cwiseMax(-12.0).cwiseMin(12.0);
+  DesignOptions options;
+  options.material = *parse_material_spec("silicone");
+  options.volume_ratio = 4.0;
+  options.max_time_s = 60;
+  const DesignResult design = design_balloon(box, options);
+  ASSERT_FALSE(design.log.empty()) << design.message;
+  ASSERT_EQ(design.stop, DesignStop::Stalled) << design_stop_name(design.stop) << ": " << design.message;
+  EXPECT_FALSE(design.converged) << design.message;
+  EXPECT_EQ(design.message.rfind("stalled", 0), 0u) << design.message;
+  ASSERT_TRUE(design.avg_error_mm && design.baseline_avg_error_mm);
+  EXPECT_LE(*design.avg_error_mm, *design.baseline_avg_error_mm);
+  std::printf("box: %s after %d iterations, avg error %.3g mm (baseline %.3g mm)\n", design.message.c_str(),
+              design.iterations, *design.avg_error_mm, *design.baseline_avg_error_mm);
 }
 
 }  // namespace

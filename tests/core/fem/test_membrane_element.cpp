@@ -180,5 +180,167 @@ TEST(MembraneElement, EquibiaxialEnergyMatchesClosedForm) {
   EXPECT_NEAR(stretches[1], l * l, 1e-6);
 }
 
+
+// Tension field (Pipkin's relaxed energy): taut, wrinkled and slack triangles, against finite
+// differences of the relaxed energy and gradient, for every law.
+struct TensionCase {
+  const char* label;
+  Material material;
+  double l1, l2;  // in-plane principal stretches applied to the rest triangle
+};
+
+std::vector<TensionCase> tension_cases() {
+  const Material silicone = make(MaterialModel::HartSmith, 0.131735, 0.0260802, 0.971018);
+  const Material latex = make(MaterialModel::HartSmith, 0.181396, 0.00029924, 0.490755);
+  return {
+      {"taut-neo-hookean", make(MaterialModel::NeoHookean, 0.3), 1.5, 1.2},
+      {"wrinkled-neo-hookean", make(MaterialModel::NeoHookean, 0.3), 1.6, 0.6},
+      {"wrinkled-mooney-rivlin", make(MaterialModel::MooneyRivlin, 0.18, 0.02), 1.6, 0.5},
+      {"wrinkled-silicone", silicone, 2.0, 0.5},
+      {"wrinkled-latex-large", latex, 4.0, 0.4},
+      {"wrinkled-near-rest", silicone, 1.05, 0.9},
+  };
+}
+
+/// Rest triangle in a tilted plane, and a deformed copy stretched by l1, l2 along in-plane axes at
+/// 30 degrees to the first edge, rotated in space, with a perturbation far below the state boundaries.
+void tension_pair(std::mt19937& rng, double l1, double l2, Vector9d& rest, Vector9d& x, double noise = 1e-3) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::Matrix<double, 2, 3> planar;
+  planar << 0, 2.0 + 0.2 * u(rng), 0.7 + 0.2 * u(rng), 0, 0.1 * u(rng), 1.6 + 0.2 * u(rng);
+  const double angle = 0.5236;
+  Eigen::Matrix2d axes;
+  axes << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
+  const Eigen::Matrix2d stretch = axes * Eigen::Vector2d(l1, l2).asDiagonal() * axes.transpose();
+  const Eigen::Matrix3d tilt = Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.9, Eigen::Vector3d(0, 1, 2).normalized()).toRotationMatrix();
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector2d p = planar.col(k);
+    const Eigen::Vector2d q = stretch * p;
+    rest.segment<3>(3 * k) = tilt * Eigen::Vector3d(p[0], p[1], 0.0);
+    x.segment<3>(3 * k) = turn * Eigen::Vector3d(q[0], q[1], 0.0) + noise * Eigen::Vector3d(u(rng), u(rng), u(rng));
+  }
+}
+
+class TensionFieldTest : public ::testing::TestWithParam<TensionCase> {};
+
+TEST_P(TensionFieldTest, GradientMatchesFiniteDifferencesOfRelaxedEnergy) {
+  const TensionCase c = GetParam();
+  std::mt19937 rng(23);
+  for (int trial = 0; trial < 5; ++trial) {
+    Vector9d rest, x;
+    tension_pair(rng, c.l1, c.l2, rest, x);
+    const RestTriangle r = make_rest_triangle(rest);
+    EXPECT_EQ(is_relaxed(r, x), c.l1 * c.l2 * c.l2 < 1.0) << c.label;
+    const Vector9d analytic = membrane_gradient(c.material, 0.5, r, x, true);
+    Vector9d numeric;
+    const double step = 1e-6 * x.norm();
+    for (int i = 0; i < 9; ++i) {
+      Vector9d xp = x, xm = x;
+      xp[i] += step;
+      xm[i] -= step;
+      numeric[i] =
+          (membrane_energy(c.material, 0.5, r, xp, true) - membrane_energy(c.material, 0.5, r, xm, true)) / (2 * step);
+    }
+    ASSERT_GT(analytic.norm(), 1e-6) << c.label;
+    EXPECT_LT(relative_error(analytic, numeric), 1e-6) << c.label << " trial " << trial;
+  }
+}
+
+TEST_P(TensionFieldTest, HessianMatchesFiniteDifferencesOfGradientAndIsPositiveSemiDefinite) {
+  const TensionCase c = GetParam();
+  std::mt19937 rng(29);
+  for (int trial = 0; trial < 5; ++trial) {
+    Vector9d rest, x;
+    tension_pair(rng, c.l1, c.l2, rest, x);
+    const RestTriangle r = make_rest_triangle(rest);
+    double energy;
+    Vector9d gradient;
+    Matrix9d analytic;
+    membrane_energy_gradient_hessian(c.material, 0.5, r, x, energy, gradient, analytic, false, true);
+    EXPECT_NEAR(energy, membrane_energy(c.material, 0.5, r, x, true), 1e-12 * std::abs(energy)) << c.label;
+    Matrix9d numeric;
+    const double step = 1e-6 * x.norm();
+    for (int i = 0; i < 9; ++i) {
+      Vector9d xp = x, xm = x;
+      xp[i] += step;
+      xm[i] -= step;
+      numeric.col(i) =
+          (membrane_gradient(c.material, 0.5, r, xp, true) - membrane_gradient(c.material, 0.5, r, xm, true)) / (2 * step);
+    }
+    ASSERT_GT(analytic.norm(), 1e-6) << c.label;
+    EXPECT_LT(relative_error(analytic, numeric), 1e-5) << c.label << " trial " << trial;
+    if (is_relaxed(r, x)) {
+      const double smallest = Eigen::SelfAdjointEigenSolver<Matrix9d>(analytic).eigenvalues().minCoeff();
+      EXPECT_GE(smallest, -1e-10 * analytic.norm()) << c.label;
+    }
+  }
+}
+
+TEST_P(TensionFieldTest, MixedRestDerivativeMatchesFiniteDifferences) {
+  const TensionCase c = GetParam();
+  std::mt19937 rng(31);
+  Vector9d rest, x;
+  tension_pair(rng, c.l1, c.l2, rest, x);
+  const Matrix9d analytic = membrane_mixed_derivative(c.material, 0.5, rest, x, true);
+  Matrix9d numeric;
+  const double step = 1e-6 * rest.norm();
+  for (int j = 0; j < 9; ++j) {
+    Vector9d rp = rest, rm = rest;
+    rp[j] += step;
+    rm[j] -= step;
+    numeric.col(j) = (membrane_gradient(c.material, 0.5, make_rest_triangle(rp), x, true) -
+                      membrane_gradient(c.material, 0.5, make_rest_triangle(rm), x, true)) /
+                     (2 * step);
+  }
+  ASSERT_GT(analytic.norm(), 1e-6) << c.label;
+  EXPECT_LT(relative_error(analytic, numeric), 1e-5) << c.label;
+}
+
+INSTANTIATE_TEST_SUITE_P(States, TensionFieldTest, ::testing::ValuesIn(tension_cases()), [](const auto& test_info) {
+  std::string name = test_info.param.label;
+  for (char& ch : name)
+    if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+  return name;
+});
+
+TEST(TensionField, SlackTriangleHasNoEnergyNoForceNoStiffness) {
+  std::mt19937 rng(37);
+  Vector9d rest, x;
+  tension_pair(rng, 0.8, 0.7, rest, x);
+  const RestTriangle r = make_rest_triangle(rest);
+  const Material nh = make(MaterialModel::NeoHookean, 0.3);
+  EXPECT_TRUE(is_relaxed(r, x));
+  EXPECT_GT(membrane_energy(nh, 0.5, r, x, false), 1e-3);  // the unrelaxed law would store energy
+  EXPECT_EQ(membrane_energy(nh, 0.5, r, x, true), 0.0);
+  EXPECT_EQ(membrane_gradient(nh, 0.5, r, x, true).norm(), 0.0);
+  double energy;
+  Vector9d gradient;
+  Matrix9d hessian;
+  membrane_energy_gradient_hessian(nh, 0.5, r, x, energy, gradient, hessian, false, true);
+  EXPECT_EQ(hessian.norm(), 0.0);
+}
+
+TEST(TensionField, EnergyIsContinuousAcrossTheWrinklingBoundary) {
+  // At l2 = l1^-1/2 the lateral stress vanishes: the relaxed and unrelaxed energies and forces agree on
+  // both sides to first order.
+  const Material silicone = make(MaterialModel::HartSmith, 0.131735, 0.0260802, 0.971018);
+  for (double l1 : {1.2, 2.0, 3.5}) {
+    const double natural = 1.0 / std::sqrt(l1);
+    for (double offset : {-1e-6, 1e-6}) {
+      std::mt19937 rng(41);
+      Vector9d rest, x;
+      tension_pair(rng, l1, natural * (1.0 + offset), rest, x, 0.0);
+      const RestTriangle r = make_rest_triangle(rest);
+      const double relaxed = membrane_energy(silicone, 0.5, r, x, true);
+      const double plain = membrane_energy(silicone, 0.5, r, x, false);
+      EXPECT_NEAR(relaxed, plain, 1e-6 * plain) << "l1 " << l1 << " offset " << offset;
+      const Vector9d g_relaxed = membrane_gradient(silicone, 0.5, r, x, true);
+      const Vector9d g_plain = membrane_gradient(silicone, 0.5, r, x, false);
+      EXPECT_LT((g_relaxed - g_plain).norm(), 1e-4 * g_plain.norm()) << "l1 " << l1 << " offset " << offset;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace balloon::fem

@@ -196,3 +196,84 @@ INSTANTIATE_TEST_SUITE_P(Samples, SampleMeshInflationTest,
 
 }  // namespace
 }  // namespace balloon
+
+namespace balloon {
+namespace {
+
+/// An icosphere with one 0.001-degree sliver: face (a, b, c) is replaced by (a, m, c), (m, b, c) and the
+/// needle (a, b, m), m inside the face at a distance tan(0.001 deg) |ab| / 2 from the midpoint of ab.
+TriMesh sphere_with_sliver(double radius, int subdivisions, double angle_deg) {
+  TriMesh mesh = make_icosphere(radius, subdivisions);
+  const int a = mesh.faces(0, 0), b = mesh.faces(0, 1), c = mesh.faces(0, 2);
+  const Eigen::RowVector3d pa = mesh.vertices.row(a), pb = mesh.vertices.row(b), pc = mesh.vertices.row(c);
+  const Eigen::RowVector3d mid = 0.5 * (pa + pb);
+  const double offset = std::tan(angle_deg * M_PI / 180.0) * 0.5 * (pb - pa).norm();
+  const int m = mesh.vertex_count();
+  mesh.vertices.conservativeResize(m + 1, 3);
+  mesh.vertices.row(m) = mid + offset * (pc - mid).normalized();
+  const int f = mesh.face_count();
+  mesh.faces.conservativeResize(f + 2, 3);
+  mesh.faces.row(0) << a, m, c;
+  mesh.faces.row(f) << m, b, c;
+  mesh.faces.row(f + 1) << a, b, m;
+  return mesh;
+}
+
+TEST(Inflation, MeshWithAThousandthOfADegreeSliverInflates) {
+  TriMesh mesh = sphere_with_sliver(50.0, 2, 0.001);
+  ASSERT_TRUE(validate_balloon_mesh(mesh).ok());
+  EXPECT_LT(min_angle_deg(mesh.vertices, mesh.faces), 0.0011);
+  for (const bool tension_field : {false, true})
+  for (const char* spec : {"silicone", "latex"}) {
+    InflationOptions options;
+    options.material = *parse_material_spec(spec);
+    options.volume_ratio = 8.0;
+    options.tension_field = tension_field;
+    const InflationResult result = inflate(mesh, options);
+    ASSERT_TRUE(result.converged) << spec << " tension field " << tension_field << ": " << result.message;
+    EXPECT_EQ(result.stop, InflationStop::Converged);
+    EXPECT_NEAR(result.volume_ratio, 8.0, 1e-6);
+    EXPECT_TRUE(result.deformed.allFinite());
+  }
+}
+
+TEST(Inflation, FlatFacedBoxInflatesFromZeroPressure) {
+  // cube_866: flat faces, which have no out-of-plane stiffness at rest, and sharp edges.
+  auto mesh = read_mesh(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/cube_866.off");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  ASSERT_TRUE(validate_balloon_mesh(*mesh).ok());
+  mesh->vertices *= 100.0 / bounding_box_diagonal(mesh->vertices);
+  InflationOptions options;
+  options.material = *parse_material_spec("silicone");
+  // Volume control barely off the stress-free state, where the pressure is close to zero.
+  options.volume_ratio = 1.01;
+  InflationResult result = inflate(*mesh, options);
+  ASSERT_TRUE(result.converged) << result.message;
+  EXPECT_NEAR(result.volume_ratio, 1.01, 1e-8);
+  EXPECT_GT(result.pressure_kpa, 0.0);
+  // Pressure control starts at p = 0 too.
+  options.control = InflationControl::Pressure;
+  options.pressure_kpa = 0.5 * result.pressure_kpa;
+  result = inflate(*mesh, options);
+  ASSERT_TRUE(result.converged) << result.message;
+  EXPECT_GT(result.volume_ratio, 1.0);
+  EXPECT_LT(result.volume_ratio, 1.01);
+}
+
+TEST(Inflation, TensionFieldChangesNothingOnATautSphere) {
+  // A sphere is in equibiaxial tension everywhere: no triangle is relaxed and the law holds as before.
+  const TriMesh sphere = make_icosphere(10.0, 2);
+  InflationOptions options;
+  options.material = *parse_material_spec("latex");
+  options.volume_ratio = 8.0;
+  options.tension_field = true;
+  const InflationResult relaxed = inflate(sphere, options);
+  options.tension_field = false;
+  const InflationResult plain = inflate(sphere, options);
+  ASSERT_TRUE(relaxed.converged && plain.converged) << relaxed.message << " / " << plain.message;
+  EXPECT_EQ(relaxed.wrinkled_elements, 0);
+  EXPECT_NEAR(relaxed.pressure_kpa, plain.pressure_kpa, 1e-9 * plain.pressure_kpa);
+}
+
+}  // namespace
+}  // namespace balloon
