@@ -35,9 +35,13 @@ std::vector<std::string> split_cells(const std::string& line) {
   return cells;
 }
 
-/// A cell as messages quote it: cut to 40 characters, so that an error never echoes a huge input.
+/// A cell as messages quote it: cut to 40 characters, control bytes as '?', so that an error stays one short line.
 std::string quoted_cell(const std::string& cell) {
-  return "'" + cell.substr(0, 40) + (cell.size() > 40 ? "...'" : "'");
+  std::string shown = cell.substr(0, 40);
+  for (char& c : shown) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  return "'" + shown + (cell.size() > 40 ? "...'" : "'");
 }
 
 std::string number_text(double v) {

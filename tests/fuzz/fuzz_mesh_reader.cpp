@@ -26,7 +26,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       balloon::read_mesh_from_memory(bytes, BALLOON_FUZZ_FORMAT, balloon::upload_limits(SERVER_MAX_VERTICES));
   if (!mesh) {
     // Every refusal is one bounded line: a message that echoes the input whole is a finding too.
-    if (mesh.error().empty() || mesh.error().size() > 2000 || mesh.error().find('\n') != std::string::npos) __builtin_trap();
+    if (mesh.error().empty() || mesh.error().size() > 2000 || mesh.error().find_first_of("\r\n") != std::string::npos) __builtin_trap();
     return 0;
   }
   if (mesh->vertex_count() > SERVER_MAX_VERTICES || mesh->face_count() > 4 * SERVER_MAX_VERTICES) __builtin_trap();

@@ -352,7 +352,7 @@ TEST(HostileInputs, CatalogueGetsItsStatusesAndTheServerStaysServingAndSmall) {
   mesh_case("ASCII PLY with a word among its numbers",
             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
             "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 x0\n3 0 1 2\n",
-            v1::MESH_FORMAT_PLY, StatusCode::INVALID_ARGUMENT, "'x0' is not a number");
+            v1::MESH_FORMAT_PLY, StatusCode::INVALID_ARGUMENT, "'x0' is not a float");
   mesh_case("glTF with bad base64", gltf_with_uri("data:application/octet-stream;base64,AA*A"), v1::MESH_FORMAT_GLTF,
             StatusCode::INVALID_ARGUMENT, "bad base64");
 

@@ -638,8 +638,15 @@ TEST(MeshIoHostile, InputsThatAssimpMishandlesAreRefusedBeforeIt) {
       "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
   const auto ply = read_mesh_from_memory(ply_header + "0 0 0\n1 0 0\n0 1 x0\n3 0 1 2\n", "ply");
   ASSERT_FALSE(ply.ok());
-  expect_contains(ply.error(), {"bad PLY data: line 12", "'x0' is not a number"});
+  expect_contains(ply.error(), {"bad PLY data: line 12", "'x0' is not a float"});
   ASSERT_TRUE(read_mesh_from_memory(ply_header + "0 0 0\n1 0 0\n0 1 -1e-3\n3 0 1 2\n", "ply").ok());
+  // Lines out of step with the header: assimp read a coordinate as a face's list length, and leaked.
+  const auto short_line = read_mesh_from_memory(ply_header + "0 0 0\n1 0\n0 1 0\n3 0 1 2\n", "ply");
+  ASSERT_FALSE(short_line.ok());
+  expect_contains(short_line.error(), {"bad PLY data: line 11", "fewer values than the header's properties"});
+  const auto float_index = read_mesh_from_memory(ply_header + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2.5\n", "ply");
+  ASSERT_FALSE(float_index.ok());
+  expect_contains(float_index.error(), {"bad PLY data: line 13", "'2.5' is not a int"});
   const auto stl = read_mesh_from_memory(
       "solid s\nfacet normal 0 0 0\nouter loop\nvertex 8.5dae 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
       "endsolid s\n", "stl");
@@ -648,6 +655,11 @@ TEST(MeshIoHostile, InputsThatAssimpMishandlesAreRefusedBeforeIt) {
   const auto empty_facet = read_mesh_from_memory("solid s\nfacet normal 0 0 0\nouter loop\nendfacet\nendsolid s\n", "stl");
   ASSERT_FALSE(empty_facet.ok());
   expect_contains(empty_facet.error(), {"bad ASCII STL: line 4", "expected 'vertex', found 'endfacet'"});
+  const auto inner_cr = read_mesh_from_memory(
+      "solid s\r\nfacet normal 0 0 0\r\nouter loop\r\nvertex 0 0 0\r\nvertex 1 0\r0\r\nvertex 0 1 0\r\nendloop\r\n"
+      "endfacet\r\nendsolid s\r\n", "stl");
+  ASSERT_FALSE(inner_cr.ok());
+  expect_contains(inner_cr.error(), {"bad ASCII STL: line 5", "expected 3 numbers after 'vertex'"});
   const auto gltf = read_mesh_from_memory(
       R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":3,"uri":"data:application/octet-stream;base64,AA\u00e9A"}]})",
       "gltf");
