@@ -8,6 +8,8 @@ PACKAGES=(
   cmake ninja-build pkg-config g++ git
   # tests and benchmarks (openssl: the HTTPS gateway test makes a self-signed certificate)
   libgtest-dev libgmock-dev libbenchmark-dev openssl
+  # fuzzing (tests/fuzz): clang with libFuzzer and the ASan/UBSan runtimes
+  clang libclang-rt-14-dev
   # numerics: Eigen, CHOLMOD (SuiteSparse) with OpenBLAS behind it, nanoflann (kd-tree), CGAL (remeshing, AABB)
   libeigen3-dev libsuitesparse-dev libopenblas0-pthread libnanoflann-dev libcgal-dev
   # mesh files

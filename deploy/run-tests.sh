@@ -7,6 +7,10 @@ cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build "$BUILD_DIR" -j"$(nproc)"
 ctest --test-dir "$BUILD_DIR" --output-on-failure -j"$(nproc)" --timeout 900
 
+# The libFuzzer targets (issue 11), 30 s each: a separate clang build of the readers (build-fuzz) with
+# ASan and UBSan; any crash, leak or input over 1 s fails the run.
+tests/fuzz/run_fuzzers.sh 30
+
 # The web page (issue 6): unit tests of its modules, then the browser test: balloon-server --http with
 # the built page, driven in headless Debian Chromium by playwright-core. npm ci runs only when
 # tests/web/package-lock.json changed.

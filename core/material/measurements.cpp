@@ -35,6 +35,15 @@ std::vector<std::string> split_cells(const std::string& line) {
   return cells;
 }
 
+/// A cell as messages quote it: cut to 40 characters, control bytes as '?', so that an error stays one short line.
+std::string quoted_cell(const std::string& cell) {
+  std::string shown = cell.substr(0, 40);
+  for (char& c : shown) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  return "'" + shown + (cell.size() > 40 ? "...'" : "'");
+}
+
 std::string number_text(double v) {
   std::ostringstream out;
   out << v;
@@ -145,10 +154,10 @@ Result<MeasurementSet> parse_measurements(const std::string& csv_text, TestKind 
         const std::string name = lower(cells[c]);
         const auto it = std::find(names.begin(), names.end(), name);
         if (it == names.end())
-          return fail(at_line + ", column " + std::to_string(c + 1) + ": unknown column '" + cells[c] + "' (expected header '" +
+          return fail(at_line + ", column " + std::to_string(c + 1) + ": unknown column " + quoted_cell(cells[c]) + " (expected header '" +
                       expected_header(kind) + "' for " + test_kind_name(kind) + " data" + hint + ")");
         const int role = static_cast<int>(it - names.begin());
-        if (seen[role]) return fail(at_line + ", column " + std::to_string(c + 1) + ": column '" + cells[c] + "' appears twice");
+        if (seen[role]) return fail(at_line + ", column " + std::to_string(c + 1) + ": column " + quoted_cell(cells[c]) + " appears twice");
         seen[role] = true;
         role_of_column.push_back(role);
       }
@@ -169,8 +178,8 @@ Result<MeasurementSet> parse_measurements(const std::string& csv_text, TestKind 
       if (text.empty()) return fail(at_cell + ": empty cell");
       char* end = nullptr;
       const double value = std::strtod(text.c_str(), &end);
-      if (end == text.c_str() || *end != '\0') return fail(at_cell + ": '" + text + "' is not a number");
-      if (!std::isfinite(value)) return fail(at_cell + ": '" + text + "' is not a finite number");
+      if (end == text.c_str() || *end != '\0') return fail(at_cell + ": " + quoted_cell(text) + " is not a number");
+      if (!std::isfinite(value)) return fail(at_cell + ": " + quoted_cell(text) + " is not a finite number");
       values[role_of_column[c]] = value;
     }
     if (stress && values[0] <= 0.0) return fail(at_line + ", column 1: stretch " + number_text(values[0]) + " must be positive");

@@ -2,10 +2,12 @@
 
 #include <Eigen/Geometry>
 
+#include <assimp/BaseImporter.h>
 #include <assimp/IOStream.hpp>
 #include <assimp/IOSystem.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/MemoryIOWrapper.h>
+#include <assimp/importerdesc.h>
 #include <assimp/scene.h>
 
 #include <algorithm>
@@ -17,7 +19,9 @@
 #include <cstdint>
 #include <cstring>
 #include <memory>
+#include <sstream>
 #include <string_view>
+#include <tuple>
 #include <unordered_map>
 #include <vector>
 
@@ -40,9 +44,13 @@ std::string one_line(std::string text) {
   return text;
 }
 
+/// At most 80 characters of `text` in quotes, control and non-ASCII bytes shown as '?': messages stay one
+/// printable line whatever the upload holds.
 std::string quoted(std::string_view text) {
   std::string out(1, '\'');
-  out += text.substr(0, 80);
+  for (const char c : text.substr(0, 80)) {
+    out += static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f ? '?' : c;
+  }
   out += text.size() > 80 ? "...'" : "'";
   return out;
 }
@@ -62,13 +70,15 @@ class SealedMemoryIOSystem : public Assimp::IOSystem {
       // MemoryIOStream does not take ownership of the buffer: m_bytes outlives the import.
       return new Assimp::MemoryIOStream(reinterpret_cast<const std::uint8_t*>(m_bytes.data()), m_bytes.size());
     }
-    m_refused.emplace_back(file == nullptr ? "" : file);
+    // assimp may ask for one name several times: the message names each once.
+    const std::string name = file == nullptr ? "" : file;
+    if (std::find(m_refused.begin(), m_refused.end(), name) == m_refused.end()) m_refused.push_back(name);
     return nullptr;
   }
   void Close(Assimp::IOStream* stream) override { delete stream; }
   bool ComparePaths(const char* one, const char* second) const override { return std::strcmp(one, second) == 0; }
 
-  /// Names assimp asked for other than the uploaded file, in order.
+  /// Distinct names assimp asked for other than the uploaded file, in order.
   const std::vector<std::string>& refused() const { return m_refused; }
 
  private:
@@ -121,14 +131,70 @@ std::vector<std::string_view> gltf_uris(std::string_view json) {
   return uris;
 }
 
-/// "" or why a glTF/GLB refers to data outside itself.
+/// JSON nesting (objects and arrays) deeper than this is refused: assimp's JSON parser (rapidjson) recurses
+/// once per level, and 200,000 levels in a 400 kB upload overflowed the stack and killed the server.
+constexpr int MAX_JSON_DEPTH = 64;
+
+/// More JSON objects than this are refused: assimp's glTF importer also recurses once per level of the node
+/// tree, which a flat array of 20,000 nodes, each the child of the one before, overflowed (measured under
+/// ASan; a balloon upload has a few dozen objects).
+constexpr int MAX_JSON_OBJECTS = 4096;
+
+/// "" or why a JSON text nests deeper than MAX_JSON_DEPTH or holds more than MAX_JSON_OBJECTS objects
+/// (strings skipped; the syntax is assimp's to check).
+std::string check_json_depth(std::string_view json) {
+  int depth = 0, objects = 0;
+  for (std::size_t i = 0; i < json.size(); ++i) {
+    const char c = json[i];
+    if (c == '"') {
+      for (++i; i < json.size() && json[i] != '"'; ++i) {
+        if (json[i] == '\\') ++i;
+      }
+    } else if (c == '{' || c == '[') {
+      if (c == '{' && ++objects > MAX_JSON_OBJECTS) {
+        return "the JSON has more than " + std::to_string(MAX_JSON_OBJECTS) + " objects (at byte " + std::to_string(i) + ")";
+      }
+      if (++depth > MAX_JSON_DEPTH) {
+        return "the JSON is nested deeper than " + std::to_string(MAX_JSON_DEPTH) + " levels (at byte " + std::to_string(i) + ")";
+      }
+    } else if (c == '}' || c == ']') {
+      --depth;
+    }
+  }
+  return {};
+}
+
+/// "" or why a glTF/GLB nests too deep or refers to data outside itself.
 std::string check_gltf_uris(std::string_view bytes, const std::string& format) {
   std::string error;
   const std::string_view json = gltf_json_text(bytes, format, error);
   if (!error.empty()) return error;
+  if (std::string problem = check_json_depth(json); !problem.empty()) return problem;
   std::vector<std::string_view> external;
   for (const std::string_view uri : gltf_uris(json)) {
-    if (uri.substr(0, 5) != "data:") external.push_back(uri);
+    if (uri.substr(0, 5) != "data:") {
+      external.push_back(uri);
+      continue;
+    }
+    // assimp 5.2 leaks the buffer it decodes when the base64 turns out bad (tests/fuzz/README.md): check first.
+    const std::size_t comma = uri.find(',');
+    const std::string_view media = uri.substr(0, comma);
+    if (comma == std::string_view::npos || media.size() < 7 || media.substr(media.size() - 7) != ";base64") {
+      return "a data: URI that is not base64 (" + quoted(uri.substr(0, 40)) + "); only base64 data: URIs are accepted";
+    }
+    // A media type as MIME spells it (assimp misreads a long odd one and then fails on the base64).
+    const std::string_view type = media.substr(5, media.size() - 12);
+    if (type.size() > 64 || type.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789/+.-") !=
+                                std::string_view::npos) {
+      return "a data: URI with a bad media type (" + quoted(type.substr(0, 40)) + ")";
+    }
+    std::string_view payload = uri.substr(comma + 1);
+    if (payload.size() % 4 != 0) return "bad base64 in a data: URI (its length is not a multiple of 4)";
+    for (int pad = 0; pad < 2 && !payload.empty() && payload.back() == '='; ++pad) payload.remove_suffix(1);
+    const std::size_t bad = payload.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/");
+    if (bad != std::string_view::npos) {
+      return "bad base64 in a data: URI (character " + std::to_string(comma + 1 + bad) + " of the URI)";
+    }
   }
   if (external.empty()) return {};
   std::string message = "refers to " + std::to_string(external.size()) + " external file" +
@@ -142,32 +208,174 @@ bool parse_count(std::string_view token, std::uint64_t& value) {
   return error == std::errc() && end == token.data() + token.size();
 }
 
-/// "" or why the counts a PLY header declares cannot be right or are over the limits.
-std::string check_ply_header(std::string_view bytes, const MeshReadLimits& limits) {
-  const std::size_t header_end = bytes.find("end_header");
-  if (header_end == std::string_view::npos) return {};  // assimp reports the missing header
-  const std::string_view header = bytes.substr(0, header_end);
-  const std::size_t body = bytes.size() - header_end;
-  for (const auto& [name, limit] : {std::pair{std::string_view("vertex"), limits.max_vertices},
-                                   std::pair{std::string_view("face"), limits.max_faces}}) {
-    const std::string prefix = "element " + std::string(name) + " ";
-    const std::size_t at = header.find(prefix);
-    if (at == std::string_view::npos) continue;
-    std::size_t end = at + prefix.size();
-    while (end < header.size() && std::isdigit(static_cast<unsigned char>(header[end]))) ++end;
-    std::uint64_t count = 0;
-    if (!parse_count(header.substr(at + prefix.size(), end - at - prefix.size()), count)) {
-      return "bad PLY header: the " + std::string(name) + " count is not a number";
+/// Words of one line, separated by spaces and tabs; a CR ends the line (CRLF). A CR inside a line is left in
+/// a word, so that the word is refused: assimp does not take it for white space.
+std::vector<std::string_view> words_of(std::string_view line) {
+  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+  std::vector<std::string_view> words;
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+    const std::size_t start = i;
+    while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
+    if (i > start) words.push_back(line.substr(start, i - start));
+  }
+  return words;
+}
+
+bool is_ply_scalar_type(std::string_view type) {
+  for (const std::string_view known : {"char", "uchar", "short", "ushort", "int", "uint", "float", "double", "int8",
+                                       "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"}) {
+    if (type == known) return true;
+  }
+  return false;
+}
+
+bool is_ply_name(std::string_view name) {
+  return !name.empty() && name.size() <= 64 && std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
+  });
+}
+
+/// True if `token` is a number as the ASCII formats write them (digits, sign, point, exponent; no nan or inf).
+bool is_number_token(std::string_view token) {
+  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
+  double value = 0.0;
+  const auto [end, error] = std::from_chars(token.data(), token.data() + token.size(), value);
+  return error != std::errc::invalid_argument && end == token.data() + token.size() &&
+         token.find_first_not_of("0123456789+-.eE") == std::string_view::npos;
+}
+
+/// One property of a PLY element: a scalar, or a list (a count, then that many values).
+struct PlyProperty {
+  bool list = false;
+  std::string_view count_type;  ///< lists only
+  std::string_view value_type;
+};
+struct PlyElement {
+  std::uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+bool is_ply_integer_type(std::string_view type) {
+  return type != "float" && type != "double" && type != "float32" && type != "float64";
+}
+
+/// True if `token` is a value of PLY `type`: any number for the float types, an integer (unsigned for the
+/// u types) otherwise.
+bool is_ply_value(std::string_view token, std::string_view type) {
+  if (!is_number_token(token)) return false;
+  if (!is_ply_integer_type(type)) return true;
+  if (token.find_first_of(".eE") != std::string_view::npos) return false;
+  return type.front() != 'u' || token.front() != '-';
+}
+
+/// "" or why an ASCII PLY body does not hold, line by line, the elements its header declares: each
+/// instance one line with one value per scalar property and a count then that many values per list.
+/// assimp 5.2 leaks the element arrays when a value does not parse or the lines fall out of step
+/// (tests/fuzz/README.md).
+std::string check_ascii_ply_body(std::string_view text, const std::vector<PlyElement>& elements, int first_line) {
+  std::size_t at = 0;
+  int line_number = first_line - 1;
+  for (const PlyElement& element : elements) {
+    for (std::uint64_t instance = 0; instance < element.count; ++instance) {
+      std::vector<std::string_view> words;
+      while (words.empty() && at < text.size()) {  // blank lines are skipped
+        const std::size_t newline = std::min(text.find('\n', at), text.size());
+        words = words_of(text.substr(at, newline - at));
+        at = newline + 1;
+        ++line_number;
+      }
+      const std::string where = "bad PLY data: line " + std::to_string(line_number) + ": ";
+      if (words.empty()) return "bad PLY data: the file ends before the header's elements do";
+      std::size_t k = 0;
+      for (const PlyProperty& property : element.properties) {
+        std::uint64_t values = 1;
+        if (property.list) {
+          if (k >= words.size() || !is_ply_value(words[k], property.count_type) || !parse_count(words[k], values)) {
+            return where + "expected a list length";
+          }
+          ++k;
+        }
+        for (std::uint64_t v = 0; v < values; ++v, ++k) {
+          if (k >= words.size()) return where + "fewer values than the header's properties";
+          if (!is_ply_value(words[k], property.value_type)) {
+            return where + quoted(words[k].substr(0, 40)) + " is not a " + std::string(property.value_type);
+          }
+        }
+      }
+      if (k != words.size()) return where + "more values than the header's properties";
     }
+  }
+  return {};
+}
+
+/// "" or why a PLY header is malformed, or declares counts that the bytes cannot hold or that are over the
+/// limits. The grammar is checked line by line here because assimp 5.2's PLY parser loops for ever on
+/// some malformed headers (an element without a name, a property line cut short): see tests/fuzz/README.md.
+std::string check_ply_header(std::string_view bytes, const MeshReadLimits& limits) {
+  std::size_t at = 0;
+  int line_number = 0;
+  bool have_format = false, have_end = false, ascii = false;
+  std::uint64_t vertex_count = 0, face_count = 0;
+  std::vector<PlyElement> elements;
+  while (at < bytes.size() && !have_end) {
+    const std::size_t newline = std::min(bytes.find('\n', at), bytes.size());
+    const std::string_view line = bytes.substr(at, newline - at);
+    at = newline + 1;
+    ++line_number;
+    const std::vector<std::string_view> words = words_of(line);
+    const std::string where = "bad PLY header: line " + std::to_string(line_number) + ": ";
+    if (line_number == 1) {
+      if (words.size() != 1 || words[0] != "ply") return "not a PLY file (the first line is not 'ply')";
+      continue;
+    }
+    if (words.empty()) return where + "empty line";
+    if (words[0] == "comment" || words[0] == "obj_info") continue;
+    if (words[0] == "format") {
+      if (have_format || words.size() != 3 ||
+          (words[1] != "ascii" && words[1] != "binary_little_endian" && words[1] != "binary_big_endian") ||
+          words[2] != "1.0") {
+        return where + "expected 'format ascii|binary_little_endian|binary_big_endian 1.0'";
+      }
+      have_format = true;
+      ascii = words[1] == "ascii";
+    } else if (words[0] == "element") {
+      std::uint64_t count = 0;
+      if (words.size() != 3 || !is_ply_name(words[1]) || !parse_count(words[2], count)) {
+        return where + "expected 'element NAME COUNT'";
+      }
+      if (words[1] == "vertex") vertex_count = count;
+      if (words[1] == "face") face_count = count;
+      elements.push_back(PlyElement{count, {}});
+    } else if (words[0] == "property") {
+      const bool list = words.size() == 5 && words[1] == "list" && is_ply_scalar_type(words[2]) &&
+                        is_ply_scalar_type(words[3]) && is_ply_name(words[4]);
+      const bool scalar = words.size() == 3 && is_ply_scalar_type(words[1]) && is_ply_name(words[2]);
+      if (!list && !scalar) return where + "expected 'property TYPE NAME' or 'property list TYPE TYPE NAME'";
+      if (elements.empty()) return where + "a property before any element";
+      elements.back().properties.push_back(list ? PlyProperty{true, words[2], words[3]} : PlyProperty{false, {}, words[1]});
+    } else if (words[0] == "end_header" && words.size() == 1) {
+      have_end = true;
+    } else {
+      return where + "unknown keyword '" + std::string(words[0].substr(0, 40)) + "'";
+    }
+  }
+  if (!have_end) return "bad PLY header: no end_header line";
+  if (!have_format) return "bad PLY header: no format line";
+  const std::size_t body = bytes.size() - std::min(at, bytes.size());
+  for (const auto& [name, count, limit] : {std::tuple{"vertex", vertex_count, limits.max_vertices},
+                                          std::tuple{"face", face_count, limits.max_faces}}) {
     // Every element takes at least one byte, so a count beyond the bytes left is a lie.
     if (count > body) {
-      return "bad PLY header: it declares " + std::to_string(count) + " " + std::string(name) +
-             " elements but only " + std::to_string(body) + " bytes follow";
+      return "bad PLY header: it declares " + std::to_string(count) + " " + name + " elements but only " +
+             std::to_string(body) + " bytes follow";
     }
     const std::string over = over_limit_message(static_cast<std::int64_t>(count), limit,
-                                                name == "vertex" ? "vertices" : "faces");
+                                                std::string_view(name) == "vertex" ? "vertices" : "faces");
     if (!over.empty()) return over;
   }
+  if (ascii) return check_ascii_ply_body(bytes.substr(std::min(at, bytes.size())), elements, line_number + 1);
   return {};
 }
 
@@ -183,10 +391,68 @@ std::string check_stl_size(std::string_view bytes, const MeshReadLimits& limits)
   return over_limit_message(static_cast<std::int64_t>(faces), limits.max_faces, "faces");
 }
 
+/// "" or why an ASCII STL is malformed: each facet is "facet normal N N N", "outer loop", three "vertex X Y Z",
+/// "endloop", "endfacet", with numbers where numbers go. assimp 5.2 leaks its arrays when a number does not
+/// parse or a facet has no vertices (tests/fuzz/README.md).
+std::string check_ascii_stl(std::string_view bytes) {
+  // What the next line must be: facet (or solid/endsolid), outer loop, vertex x3, endloop, endfacet.
+  enum class Next { Facet, OuterLoop, Vertex, EndLoop, EndFacet };
+  Next next = Next::Facet;
+  int vertices = 0;
+  std::size_t at = 0;
+  int line_number = 0;
+  while (at < bytes.size()) {
+    const std::size_t newline = std::min(bytes.find('\n', at), bytes.size());
+    const std::vector<std::string_view> words = words_of(bytes.substr(at, newline - at));
+    at = newline + 1;
+    ++line_number;
+    if (words.empty()) continue;
+    const std::string where = "bad ASCII STL: line " + std::to_string(line_number) + ": ";
+    std::size_t first_number = 0;
+    if (next == Next::Facet && (words[0] == "solid" || words[0] == "endsolid")) continue;  // the name is free text
+    if (next == Next::Facet && words[0] == "facet" && words.size() >= 2 && words[1] == "normal") {
+      first_number = 2;
+      next = Next::OuterLoop;
+    } else if (next == Next::OuterLoop && words.size() == 2 && words[0] == "outer" && words[1] == "loop") {
+      next = Next::Vertex;
+      vertices = 0;
+      continue;
+    } else if (next == Next::Vertex && words[0] == "vertex") {
+      first_number = 1;
+      if (++vertices == 3) next = Next::EndLoop;
+    } else if (next == Next::EndLoop && words.size() == 1 && words[0] == "endloop") {
+      next = Next::EndFacet;
+      continue;
+    } else if (next == Next::EndFacet && words.size() == 1 && words[0] == "endfacet") {
+      next = Next::Facet;
+      continue;
+    } else {
+      static constexpr const char* EXPECTED[] = {"'facet normal' or 'endsolid'", "'outer loop'", "'vertex'", "'endloop'",
+                                                 "'endfacet'"};
+      return where + "expected " + EXPECTED[static_cast<int>(next)] + ", found " + quoted(words[0].substr(0, 40));
+    }
+    if (words.size() != first_number + 3) {
+      return where + "expected 3 numbers after '" + std::string(words[first_number - 1]) + "'";
+    }
+    for (std::size_t k = first_number; k < words.size(); ++k) {
+      if (!is_number_token(words[k])) return where + quoted(words[k].substr(0, 40)) + " is not a number";
+    }
+  }
+  if (next != Next::Facet) return "bad ASCII STL: the last facet is not complete";
+  return {};
+}
+
 std::string check_before_parse(std::string_view bytes, const std::string& format, const MeshReadLimits& limits) {
   if (format == "gltf" || format == "glb") return check_gltf_uris(bytes, format);
   if (format == "ply") return check_ply_header(bytes, limits);
-  if (format == "stl") return check_stl_size(bytes, limits);
+  if (format == "stl") {
+    const bool binary = bytes.size() >= 84 && 84 + 50 * static_cast<std::uint64_t>(read_u32(bytes, 80)) == bytes.size();
+    const std::size_t start = std::min(bytes.find_first_not_of(" \t\r\n"), bytes.size());
+    if (!binary && bytes.substr(start, 5) == "solid") {
+      if (std::string problem = check_ascii_stl(bytes); !problem.empty()) return problem;
+    }
+    return check_stl_size(bytes, limits);
+  }
   return {};
 }
 
@@ -334,9 +600,9 @@ class SceneMerger {
 // distinct vertices of small meshes) and not across meshes; SceneMerger welds exact positions instead.
 constexpr unsigned ASSIMP_FLAGS = 0;
 
-Result<TriMesh> scene_to_mesh(const aiScene* scene, const Assimp::Importer& importer, const MeshReadLimits& limits) {
+Result<TriMesh> scene_to_mesh(const aiScene* scene, const std::string& error, const MeshReadLimits& limits) {
   if (scene == nullptr) {
-    std::string reason = one_line(importer.GetErrorString());
+    std::string reason = one_line(error);
     // Reading from memory, assimp names the data after a made-up file; say "the data" instead.
     for (std::size_t at = reason.find(MEMORY_FILE_NAME); at != std::string::npos; at = reason.find(MEMORY_FILE_NAME)) {
       std::size_t end = at + MEMORY_FILE_NAME.size();
@@ -344,9 +610,30 @@ Result<TriMesh> scene_to_mesh(const aiScene* scene, const Assimp::Importer& impo
       if (end > at + MEMORY_FILE_NAME.size() && reason[end - 1] == '.') --end;  // keep a sentence's full stop
       reason.replace(at, end - at, "the data");
     }
+    // assimp quotes the offending bytes, however many and whatever they are: keep a short printable line.
+    for (char& c : reason) {
+      if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
+    }
+    if (reason.size() > 200) reason = reason.substr(0, 200) + "...";
     return fail("parse error: " + (reason.empty() ? std::string("unknown assimp error") : reason));
   }
   return SceneMerger(*scene, limits).merge();
+}
+
+/// The importer assimp registers for `format` (an extension); for glTF the 2.0 one, as the upload promises.
+Assimp::BaseImporter* importer_for(const Assimp::Importer& importer, const std::string& format) {
+  for (std::size_t i = 0; i < importer.GetImporterCount(); ++i) {
+    const aiImporterDesc* info = importer.GetImporterInfo(i);
+    if (info == nullptr || info->mFileExtensions == nullptr) continue;
+    std::istringstream extensions(info->mFileExtensions);
+    for (std::string extension; extensions >> extension;) {
+      const bool gltf = format == "gltf" || format == "glb";
+      if (extension == format && (!gltf || std::string_view(info->mName).find("glTF2") != std::string_view::npos)) {
+        return importer.GetImporter(i);
+      }
+    }
+  }
+  return nullptr;
 }
 
 std::string refused_files_message(const std::vector<std::string>& refused) {
@@ -364,16 +651,20 @@ Result<TriMesh> read_with_assimp(const std::string& bytes, const std::string& fo
   Assimp::Importer importer;
   auto* io = new SealedMemoryIOSystem(bytes, name);
   importer.SetIOHandler(io);  // the importer owns and deletes it
-  const aiScene* scene = importer.ReadFile(name, ASSIMP_FLAGS);
+  // The declared format's importer only: Importer::ReadFile falls back to guessing the format from the bytes,
+  // which hands an upload to any of assimp's ~40 importers (fuzzing reached a heap overflow that way).
+  Assimp::BaseImporter* reader = importer_for(importer, format);
+  if (reader == nullptr) return fail("this assimp has no " + format + " importer");
+  const std::unique_ptr<aiScene> scene(reader->ReadFile(&importer, name, io));
   // Refused names come first: even when assimp carried on without them, the upload was not self-contained.
   if (!io->refused().empty()) return fail(refused_files_message(io->refused()));
-  return scene_to_mesh(scene, importer, limits);
+  return scene_to_mesh(scene.get(), reader->GetErrorText(), limits);
 }
 
 Result<TriMesh> read_file_with_assimp(const std::string& path, const MeshReadLimits& limits) {
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(path, ASSIMP_FLAGS);
-  return scene_to_mesh(scene, importer, limits);
+  return scene_to_mesh(scene, importer.GetErrorString(), limits);
 }
 
 }  // namespace balloon

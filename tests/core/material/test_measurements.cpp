@@ -86,6 +86,14 @@ TEST(Measurements, BadInputGivesClearErrors) {
   expect_error("# c\n# c\n" + header + "1.1,0.1\nabc,0.2\n", TestKind::Uniaxial, "line 5, column 1: 'abc' is not a number");
   expect_error("# c\n# c\n" + header + "1.1,0.1\n1.2,abc\n", TestKind::Uniaxial, "line 5, column 2: 'abc' is not a number");
   expect_error(header + "1.1,0.1x\n1.2,0.2\n", TestKind::Uniaxial, "line 2, column 2: '0.1x' is not a number");
+  {
+    // A huge cell is quoted by its first 40 characters: the message stays one short line.
+    const auto parsed = parse_measurements(header + "1.1," + std::string(100000, '7') + "x\n1.2,0.2\n", TestKind::Uniaxial);
+    ASSERT_FALSE(parsed.ok());
+    EXPECT_NE(parsed.error().find("line 2, column 2: '" + std::string(40, '7') + "...' is not a number"), std::string::npos)
+        << parsed.error().substr(0, 200);
+    EXPECT_LT(parsed.error().size(), 120u);
+  }
   expect_error(header + "1.1,inf\n1.2,0.2\n", TestKind::Uniaxial, "line 2, column 2: 'inf' is not a finite number");
   expect_error(header + "1.1,nan\n1.2,0.2\n", TestKind::Uniaxial, "line 2, column 2: 'nan' is not a finite number");
   expect_error(header + "1.1,\n1.2,0.2\n", TestKind::Uniaxial, "line 2, column 2: empty cell");

@@ -627,6 +627,69 @@ TEST(MeshIoHostile, HeaderBombsAreRefusedBeforeAllocation) {
   EXPECT_TRUE(is_over_limit_error(limited.error()));
 }
 
+TEST(MeshIoHostile, InputsThatAssimpMishandlesAreRefusedBeforeIt) {
+  // Found by tests/fuzz: assimp 5.2 loops for ever on this PLY header (an element without a name)...
+  const auto nameless = read_mesh_from_memory("ply\nformat ascii 1.0\nelement 1\n1 0.125 0.625\nend_header\n", "ply");
+  ASSERT_FALSE(nameless.ok());
+  expect_contains(nameless.error(), {"bad PLY header: line 3", "element NAME COUNT"});
+  // ...and leaks its arrays when an ASCII PLY or STL number, or a glTF's base64, does not parse.
+  const std::string ply_header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const auto ply = read_mesh_from_memory(ply_header + "0 0 0\n1 0 0\n0 1 x0\n3 0 1 2\n", "ply");
+  ASSERT_FALSE(ply.ok());
+  expect_contains(ply.error(), {"bad PLY data: line 12", "'x0' is not a float"});
+  ASSERT_TRUE(read_mesh_from_memory(ply_header + "0 0 0\n1 0 0\n0 1 -1e-3\n3 0 1 2\n", "ply").ok());
+  // Lines out of step with the header: assimp read a coordinate as a face's list length, and leaked.
+  const auto short_line = read_mesh_from_memory(ply_header + "0 0 0\n1 0\n0 1 0\n3 0 1 2\n", "ply");
+  ASSERT_FALSE(short_line.ok());
+  expect_contains(short_line.error(), {"bad PLY data: line 11", "fewer values than the header's properties"});
+  const auto float_index = read_mesh_from_memory(ply_header + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2.5\n", "ply");
+  ASSERT_FALSE(float_index.ok());
+  expect_contains(float_index.error(), {"bad PLY data: line 13", "'2.5' is not a int"});
+  const auto stl = read_mesh_from_memory(
+      "solid s\nfacet normal 0 0 0\nouter loop\nvertex 8.5dae 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
+      "endsolid s\n", "stl");
+  ASSERT_FALSE(stl.ok());
+  expect_contains(stl.error(), {"bad ASCII STL: line 4", "'8.5dae' is not a number"});
+  const auto empty_facet = read_mesh_from_memory("solid s\nfacet normal 0 0 0\nouter loop\nendfacet\nendsolid s\n", "stl");
+  ASSERT_FALSE(empty_facet.ok());
+  expect_contains(empty_facet.error(), {"bad ASCII STL: line 4", "expected 'vertex', found 'endfacet'"});
+  const auto inner_cr = read_mesh_from_memory(
+      "solid s\r\nfacet normal 0 0 0\r\nouter loop\r\nvertex 0 0 0\r\nvertex 1 0\r0\r\nvertex 0 1 0\r\nendloop\r\n"
+      "endfacet\r\nendsolid s\r\n", "stl");
+  ASSERT_FALSE(inner_cr.ok());
+  expect_contains(inner_cr.error(), {"bad ASCII STL: line 5", "expected 3 numbers after 'vertex'"});
+  const auto gltf = read_mesh_from_memory(
+      R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":3,"uri":"data:application/octet-stream;base64,AA\u00e9A"}]})",
+      "gltf");
+  ASSERT_FALSE(gltf.ok());
+  expect_contains(gltf.error(), {"bad base64 in a data: URI"});
+  // Found by the catalogue: rapidjson recursed once per level, and 200,000 levels overflowed the stack.
+  const auto deep = read_mesh_from_memory(
+      R"({"asset":{"version":"2.0"},"extras":)" + std::string(200000, '[') + std::string(200000, ']') + "}", "gltf");
+  ASSERT_FALSE(deep.ok());
+  expect_contains(deep.error(), {"nested deeper than 64 levels"});
+  // A node tree 20,000 deep in a flat array overflowed it too (each node the child of the one before).
+  std::string chain = R"({"asset":{"version":"2.0"},"nodes":[)";
+  for (int i = 0; i < 20000; ++i) chain += R"({"children":[)" + std::to_string(i + 1) + "]},";
+  chain += "{}]}";
+  const auto deep_nodes = read_mesh_from_memory(chain, "gltf");
+  ASSERT_FALSE(deep_nodes.ok());
+  expect_contains(deep_nodes.error(), {"more than 4096 objects"});
+}
+
+TEST(MeshIoHostile, OnlyTheDeclaredFormatsImporterReadsTheBytes) {
+  // assimp's ReadFile guesses another format when the declared one's importer declines: an OBJ sent as
+  // STL or glTF was read by the OBJ importer. Now the declared importer alone reads it, and refuses it.
+  const std::string obj = write_mesh_to_memory(make_icosphere(1.0, 0), "obj");
+  for (const char* format : {"stl", "gltf", "glb"}) {
+    SCOPED_TRACE(format);
+    const auto result = read_mesh_from_memory(obj, format);
+    EXPECT_FALSE(result.ok());
+  }
+}
+
 TEST(MeshIoHostile, LimitsHoldForEveryFormat) {
   const TriMesh sphere = make_icosphere(1.0, 2);  // 162 vertices, 320 faces
   const MeshReadLimits few_vertices{100, 0};
