@@ -49,22 +49,9 @@ std::string nozzle_problem(TriMesh target, const jobs::DesignParameters& paramet
 /// Cheap: the target is read and, with `check_mesh`, checked closed and manifold, but not remeshed.
 ServiceStatus decode_design(const v1::DesignJob& job, const std::string& tenant, int max_vertices, bool check_mesh,
                             MaterialHandler& materials, DecodedDesign* decoded) {
-  if (job.target_mesh().data().empty())
-    return ServiceStatus::error(StatusCode::InvalidArgument, "target_mesh is empty");
-  const std::string extension = mesh_format_extension(job.target_mesh().format());
-  if (extension.empty())
-    return ServiceStatus::error(StatusCode::InvalidArgument,
-                                "target_mesh.format is missing or unknown (OBJ, STL, PLY, OFF, GLTF, GLB)");
-  Result<TriMesh> mesh = read_mesh_from_memory(job.target_mesh().data(), extension, upload_limits(max_vertices));
-  if (!mesh) {
-    return ServiceStatus::error(
-        is_over_limit_error(mesh.error()) ? StatusCode::ResourceExhausted : StatusCode::InvalidArgument,
-        "target_mesh: " + mesh.error());
-  }
-  if (max_vertices > 0 && mesh->vertex_count() > max_vertices)
-    return ServiceStatus::error(StatusCode::ResourceExhausted,
-                                "target_mesh has " + std::to_string(mesh->vertex_count()) +
-                                    " vertices, over this server's limit of " + std::to_string(max_vertices));
+  TriMesh mesh;
+  if (ServiceStatus read = read_uploaded_mesh(job.target_mesh(), "target_mesh", max_vertices, &mesh); !read.ok())
+    return read;
   Result<Material> material = materials.resolve(tenant, job.material());
   if (!material) return ServiceStatus::error(StatusCode::InvalidArgument, "material: " + material.error());
 
@@ -94,13 +81,13 @@ ServiceStatus decode_design(const v1::DesignJob& job, const std::string& tenant,
       return ServiceStatus::error(StatusCode::InvalidArgument,
                                   "target_mesh: resolution must be 0 (never remesh) or at least 100 vertices, got " +
                                       std::to_string(parameters.resolution));
-    TriMesh checked = *mesh;
+    TriMesh checked = mesh;
     if (Result<MeshCheckReport> report = validate_balloon_mesh(checked); !report)
       return ServiceStatus::error(StatusCode::InvalidArgument, "target_mesh: target mesh: " + report.error());
     if (const std::string problem = nozzle_problem(std::move(checked), parameters); !problem.empty())
       return ServiceStatus::error(StatusCode::InvalidArgument, problem);
   }
-  decoded->target = std::move(*mesh);
+  decoded->target = std::move(mesh);
   decoded->material = std::move(*material);
   return ServiceStatus::success();
 }

@@ -12,21 +12,9 @@ namespace v1 = balloon::v1;
 /// Decodes and checks a simulate job (mesh within `max_vertices`, material, parameters).
 ServiceStatus load_simulate(const v1::SimulateJob& job, const std::string& tenant, int max_vertices,
                             MaterialHandler& materials, std::optional<jobs::SimulateInput>* loaded) {
-  if (job.rest_mesh().data().empty()) return ServiceStatus::error(StatusCode::InvalidArgument, "rest_mesh is empty");
-  const std::string extension = mesh_format_extension(job.rest_mesh().format());
-  if (extension.empty())
-    return ServiceStatus::error(StatusCode::InvalidArgument,
-                                "rest_mesh.format is missing or unknown (OBJ, STL, PLY, OFF, GLTF, GLB)");
-  Result<TriMesh> mesh = read_mesh_from_memory(job.rest_mesh().data(), extension, upload_limits(max_vertices));
-  if (!mesh) {
-    return ServiceStatus::error(
-        is_over_limit_error(mesh.error()) ? StatusCode::ResourceExhausted : StatusCode::InvalidArgument,
-        "rest_mesh: " + mesh.error());
-  }
-  if (max_vertices > 0 && mesh->vertex_count() > max_vertices)
-    return ServiceStatus::error(StatusCode::ResourceExhausted,
-                                "rest_mesh has " + std::to_string(mesh->vertex_count()) +
-                                    " vertices, over this server's limit of " + std::to_string(max_vertices));
+  TriMesh mesh;
+  if (ServiceStatus read = read_uploaded_mesh(job.rest_mesh(), "rest_mesh", max_vertices, &mesh); !read.ok())
+    return read;
   Result<Material> material = materials.resolve(tenant, job.material());
   if (!material) return ServiceStatus::error(StatusCode::InvalidArgument, "material: " + material.error());
 
@@ -34,7 +22,7 @@ ServiceStatus load_simulate(const v1::SimulateJob& job, const std::string& tenan
   parameters.thickness_mm = job.thickness_mm() == 0.0 ? jobs::DEFAULT_THICKNESS_MM : job.thickness_mm();
   if (job.control_case() == v1::SimulateJob::kPressureKpa) parameters.pressure_kpa = job.pressure_kpa();
   if (job.control_case() == v1::SimulateJob::kVolumeRatio) parameters.volume_ratio = job.volume_ratio();
-  Result<jobs::SimulateInput> input = jobs::prepare_simulate(std::move(*mesh), *material, parameters);
+  Result<jobs::SimulateInput> input = jobs::prepare_simulate(std::move(mesh), *material, parameters);
   if (!input) {
     // prepare_simulate prefixes mesh problems with "mesh: "; name the field the caller knows.
     std::string message = input.error();
