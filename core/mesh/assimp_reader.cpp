@@ -358,7 +358,7 @@ std::string check_ply_header(std::string_view bytes, const MeshReadLimits& limit
     } else if (words[0] == "end_header" && words.size() == 1) {
       have_end = true;
     } else {
-      return where + "unknown keyword '" + std::string(words[0].substr(0, 40)) + "'";
+      return where + "unknown keyword " + quoted(words[0].substr(0, 40));
     }
   }
   if (!have_end) return "bad PLY header: no end_header line";
