@@ -12,6 +12,9 @@
 namespace balloon::jobs {
 namespace {
 
+/// The largest inflation a design accepts (V / V0); latex, the stretchiest rubber, reaches about 125.
+constexpr double MAX_VOLUME_RATIO = 1000.0;
+
 std::string format_number(double value) {
   char buffer[64];
   std::snprintf(buffer, sizeof(buffer), "%.6g", value);
@@ -70,10 +73,16 @@ std::string design_parameters_problem(const DesignParameters& parameters) {
     return "resolution must be at least 50 vertices (or 0 to keep the target's), got " +
            std::to_string(parameters.resolution);
   if (parameters.scale && parameters.volume_ratio) return "give either a scale or a volume ratio, not both";
-  if (parameters.scale && (!std::isfinite(*parameters.scale) || *parameters.scale <= 0.0))
-    return "scale must be a positive number, got " + format_number(*parameters.scale);
-  if (parameters.volume_ratio && (!std::isfinite(*parameters.volume_ratio) || *parameters.volume_ratio <= 0.0))
-    return "volume ratio must be a positive number, got " + format_number(*parameters.volume_ratio);
+  // A balloon inflated more than MAX_VOLUME_RATIO-fold (scale below its cube root) is no rubber's: refused
+  // here rather than failing deep in the solver (a start shrunk to nothing has zero-length edges).
+  if (parameters.scale && (!std::isfinite(*parameters.scale) || *parameters.scale < std::cbrt(1.0 / MAX_VOLUME_RATIO)))
+    return "scale must be a number of at least " + format_number(std::cbrt(1.0 / MAX_VOLUME_RATIO)) + ", got " +
+           format_number(*parameters.scale);
+  if (parameters.volume_ratio &&
+      (!std::isfinite(*parameters.volume_ratio) || *parameters.volume_ratio <= 0.0 ||
+       *parameters.volume_ratio > MAX_VOLUME_RATIO))
+    return "volume ratio must be a positive number up to " + format_number(MAX_VOLUME_RATIO) + ", got " +
+           format_number(*parameters.volume_ratio);
   if (!parameters.method.empty()) {
     Result<DesignMethod> method = parse_design_method(parameters.method);
     if (!method) return "method: " + method.error();

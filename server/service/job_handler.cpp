@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -28,6 +29,14 @@ constexpr int FAIL_WRITE_ATTEMPTS = 3;
 constexpr std::size_t MAX_REQUEST_ID_LENGTH = 128;
 constexpr std::chrono::hours RETENTION_INTERVAL{1};  // how often old finished jobs are deleted
 constexpr std::int64_t REQUEST_ID_WINDOW_MS = 24LL * 3600 * 1000;  // a repeat within 24 h returns the first job
+
+/// NOT_FOUND for a job id, quoting at most 64 characters of it: a hostile 100 kB id would otherwise come
+/// back in the status message and overflow the client's metadata limit.
+ServiceStatus job_not_found(const std::string& job_id) {
+  constexpr std::size_t SHOWN = 64;
+  const std::string shown = job_id.size() > SHOWN ? job_id.substr(0, SHOWN) + "..." : job_id;
+  return ServiceStatus::error(StatusCode::NotFound, "no job '" + shown + "'");
+}
 
 /// Empty when `request_id` is a usable idempotency key, else the problem.
 std::string request_id_problem(const std::string& request_id) {
@@ -272,7 +281,7 @@ void JobHandler::fill_job(const store::JobRecord& record, v1::Job* job) const {
 
 ServiceStatus JobHandler::get(const Caller& caller, const v1::GetJobRequest& request, v1::Job* reply) {
   const auto record = find_owned(caller, request.job_id());
-  if (!record) return ServiceStatus::error(StatusCode::NotFound, "no job '" + request.job_id() + "'");
+  if (!record) return job_not_found(request.job_id());
   fill_job(*record, reply);
   return ServiceStatus::success();
 }
@@ -284,8 +293,9 @@ ServiceStatus JobHandler::list(const Caller& caller, const v1::ListJobsRequest& 
   std::int64_t before_row = 0;
   if (!request.page_token().empty()) {
     char* end = nullptr;
+    errno = 0;
     before_row = std::strtoll(request.page_token().c_str(), &end, 10);
-    if (*end != '\0' || before_row <= 0)
+    if (*end != '\0' || errno == ERANGE || before_row <= 0)
       return ServiceStatus::error(StatusCode::InvalidArgument, "page_token is not one this server gave out");
   }
   std::optional<JobState> state;
@@ -306,7 +316,7 @@ ServiceStatus JobHandler::list(const Caller& caller, const v1::ListJobsRequest& 
 
 ServiceStatus JobHandler::cancel(const Caller& caller, const v1::CancelJobRequest& request, v1::Job* reply) {
   auto record = find_owned(caller, request.job_id());
-  if (!record) return ServiceStatus::error(StatusCode::NotFound, "no job '" + request.job_id() + "'");
+  if (!record) return job_not_found(request.job_id());
   if (!store::is_terminal(record->state)) {
     // The store first: if its write fails the job is still queued (in memory and on disk) and the caller
     // gets an error; a worker that pops it meanwhile finds it cancelled and skips it.
@@ -327,7 +337,7 @@ ServiceStatus JobHandler::cancel(const Caller& caller, const v1::CancelJobReques
 
 ServiceStatus JobHandler::remove(const Caller& caller, const v1::DeleteJobRequest& request, v1::DeleteJobResponse*) {
   const auto record = find_owned(caller, request.job_id());
-  if (!record) return ServiceStatus::error(StatusCode::NotFound, "no job '" + request.job_id() + "'");
+  if (!record) return job_not_found(request.job_id());
   if (!store::is_terminal(record->state) || !m_jobs.delete_finished(record->row_id))
     return ServiceStatus::error(StatusCode::FailedPrecondition,
                                 "job " + record->job_id + " is " + store::to_string(record->state) +
@@ -361,11 +371,11 @@ ServiceStatus JobHandler::watch(const Caller& caller, const v1::WatchJobRequest&
                                 std::shared_ptr<WatchChannel>* channel) {
   if (m_pool.stopping()) return ServiceStatus::error(StatusCode::Unavailable, "the server is shutting down");
   if (!find_owned(caller, request.job_id()))
-    return ServiceStatus::error(StatusCode::NotFound, "no job '" + request.job_id() + "'");
+    return job_not_found(request.job_id());
   // The snapshot is taken under the hub's lock: publishers wait, so the snapshot comes first.
   const auto first_events = [&](WatchChannel& opened, bool* subscribe) {
     const auto record = m_jobs.find(request.job_id());
-    if (!record) return ServiceStatus::error(StatusCode::NotFound, "no job '" + request.job_id() + "'");
+    if (!record) return job_not_found(request.job_id());
     v1::JobEvent snapshot = state_event(record->job_id, to_proto(record->state), "");
     if (record->last_progress) fill_progress(*record->last_progress, snapshot.mutable_progress());
     snapshot.set_converged(record->converged);
@@ -386,7 +396,7 @@ void JobHandler::unwatch(const std::shared_ptr<WatchChannel>& channel) { m_watch
 
 ServiceStatus JobHandler::result(const Caller& caller, const v1::GetResultRequest& request, v1::JobResult* reply) {
   const auto record = find_owned(caller, request.job_id());
-  if (!record) return ServiceStatus::error(StatusCode::NotFound, "no job '" + request.job_id() + "'");
+  if (!record) return job_not_found(request.job_id());
   if (record->state != JobState::Completed) {
     std::string why = "job " + record->job_id + " is " + store::to_string(record->state);
     if (!record->error.empty()) why += " (" + record->error + ")";
