@@ -12,7 +12,7 @@ ctest --test-dir "$BUILD_DIR" --output-on-failure -j"$(nproc)" --timeout 900 --r
 
 # The libFuzzer targets (issue 11), 30 s each: a separate clang build of the readers (build-fuzz) with
 # ASan and UBSan; any crash, leak or input over 1 s fails the run.
-tests/fuzz/run_fuzzers.sh 30
+tests/fuzz/run_fuzzers.sh "${FUZZ_SECONDS:-30}"
 
 # The web page (issue 6): unit tests of its modules, then the browser test: balloon-server --http with
 # the built page, driven in headless Debian Chromium by playwright-core. npm ci runs only when

@@ -55,9 +55,11 @@ for target in "${targets[@]}"; do
   # -timeout=1: an input over 1 s is a finding; -rss_limit_mb: a reader that allocates 2 GB is one too.
   # detect_leaks is on by default under ASan; -error_exitcode makes every finding the same non-zero.
   # The outer timeout: libFuzzer's own timeout handler can deadlock while it reports (seen with ASan).
-  # A fixed -seed (FUZZ_SEED, default 1) makes a run from the fresh seeds replay the same mutations: a
-  # CI run is a prefix of a longer local run with the same seed, not a new lottery.
-  if timeout -k 10 $((duration + 120)) "$build/tests/fuzz/$target" -seed="${FUZZ_SEED:-1}" -max_total_time="$duration" -timeout=1 -rss_limit_mb=2048 \
+  # A fixed -seed (FUZZ_SEED, default 1) and a cap on executions (FUZZ_MAX_RUNS, default 20000) make a run
+  # from the fresh seeds replay the same mutations, stopping at the cap or at DURATION_S, whichever comes
+  # first: CI's run is a prefix of one checked here with a longer DURATION_S, not a new lottery.
+  if timeout -k 10 $((duration + 120)) "$build/tests/fuzz/$target" -seed="${FUZZ_SEED:-1}" -runs="${FUZZ_MAX_RUNS:-20000}" \
+      -max_total_time="$duration" -timeout=1 -rss_limit_mb=2048 \
       -error_exitcode=77 -timeout_exitcode=78 -artifact_prefix="$findings/" -print_final_stats=1 \
       "$corpus" "$build/seeds/$target" >"$log" 2>&1; then
     grep -E '^stat::number_of_executed_units|^#[0-9]+.*DONE' "$log" | tail -2 | sed "s/^/  /"
