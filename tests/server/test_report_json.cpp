@@ -1,6 +1,7 @@
 // report.json (proto/contract/report_json): the protobuf JSON mapping of a report with null for numbers
 // never computed, stable bytes, and readable back by protobuf's own parser.
 #include <gtest/gtest.h>
+#include <google/protobuf/struct.pb.h>
 #include <google/protobuf/util/json_util.h>
 #include <google/protobuf/util/message_differencer.h>
 
@@ -88,6 +89,39 @@ TEST(ReportJson, ProtobufReadsItBackToTheSameMessage) {
   v1::SimulateReport read;
   ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(json, &read).ok());
   EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(read, simulate));
+}
+
+// Where every optional field is set, report.json holds what protobuf's own printer holds (MessageToJsonString
+// with the .proto names and every field): the same keys with the same values, maps included.
+TEST(ReportJson, IsProtobufsJsonMappingWhenNothingIsMissing) {
+  v1::DesignReport design = design_with_errors();
+  design.set_baseline_avg_error_mm(0.5);
+  design.set_baseline_max_error_mm(2.0);
+  design.set_baseline_avg_error_rel(0.005);
+  design.set_improvement_over_baseline(2.0);
+  design.set_resumed_from_iteration(3);
+  design.set_mold_problem("");
+  design.mutable_nozzle()->set_center_vertex(4);
+  design.mutable_nozzle()->set_radius_mm(1.25);
+  design.mutable_tolerance()->add_levels()->set_perturbation(0.1);
+  v1::FitReport fit;
+  v1::FitModelReport* model = fit.add_fits();
+  (*model->mutable_params())["C1"] = 0.18;
+  (*model->mutable_params())["C2"] = 0.02;
+  model->add_sets()->set_label("a.csv");
+  for (const google::protobuf::Message* report : {static_cast<const google::protobuf::Message*>(&design),
+                                                  static_cast<const google::protobuf::Message*>(&fit)}) {
+    google::protobuf::util::JsonPrintOptions options;
+    options.preserve_proto_field_names = true;
+    options.always_print_primitive_fields = true;
+    std::string theirs;
+    ASSERT_TRUE(google::protobuf::util::MessageToJsonString(*report, &theirs, options).ok());
+    google::protobuf::Value ours_value, theirs_value;
+    ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(report_json(*report), &ours_value).ok());
+    ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(theirs, &theirs_value).ok());
+    EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(ours_value, theirs_value))
+        << "ours:   " << report_json(*report) << "theirs: " << theirs;
+  }
 }
 
 TEST(ReportJson, MapsAreSortedAndNonFiniteNumbersAreNull) {
