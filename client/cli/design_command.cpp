@@ -13,7 +13,6 @@
 
 #include "cli_output.hpp"
 #include "commands.hpp"
-#include "contract/report_json.hpp"
 #include "contract/job_result_files.hpp"
 #include "design/balloon_design.hpp"
 #include "exit_codes.hpp"

@@ -76,8 +76,8 @@ struct DesignOutcome {
 };
 
 /// Runs the design (progress phases "design", then "tolerance"; the cancel token is checked between
-/// iterations), the tolerance check if asked, and builds the mold (the server stores it with the result). controls.max_time_s, when set,
-/// caps the optimizer's budget. Never throws for non-convergence: that is `result.converged == false`.
+/// iterations), the tolerance check if asked, and builds the mold (the server stores it with the result).
+/// controls.max_time_s, when set, caps the optimizer's budget. Never throws for non-convergence: that is `result.converged == false`.
 /// `resume`: the design's last checkpoint when it runs again after an interruption (see DesignOptions).
 DesignOutcome run_design(const DesignInput& input, const RunControls& controls,
                          const std::optional<DesignCheckpoint>& resume = std::nullopt);
