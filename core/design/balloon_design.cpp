@@ -12,8 +12,8 @@
 #include <optional>
 
 #include "design/adjoint_sensitivity.hpp"
+#include "design/design_objective.hpp"
 #include "design/distance_energy.hpp"
-#include "design/self_collision.hpp"
 #include "design/surface_distance.hpp"
 #include "fem/balloon_model.hpp"
 #include "fem/membrane_element.hpp"
@@ -50,11 +50,6 @@ Result<DesignMethod> parse_design_method(const std::string& name) {
 namespace {
 
 constexpr double MPA_PER_KPA = 1e-3;
-/// A start hinge flatter than this (rad) counts as coplanar: it switches the rest-bending term on.
-constexpr double COPLANAR_HINGE_RAD = 1e-3;
-/// Rest-bending stiffness relative to E_dist's k_bending: enough to fix the null space of flat regions,
-/// small enough not to pull the design away from the target.
-constexpr double REST_BENDING_WEIGHT = 1e-2;
 /// The adjoint method stops when neither the average surface error (what the maker sees) nor the
 /// objective has improved by STALL_IMPROVEMENT (relative) in STALL_ITERATIONS iterations, or when the
 /// average error is below MATCH_TOLERANCE_REL of the target's diagonal (0.01 mm on 100 mm, far below
@@ -67,9 +62,6 @@ constexpr double STALL_OBJECTIVE_DECREASE = 0.1;
 constexpr double MATCH_TOLERANCE_REL = 1e-4;
 /// First-order optimality: the design gradient below this fraction of its value at the start.
 constexpr double OPTIMALITY_TOLERANCE = 1e-6;
-/// A stalled design whose inflated shape is further than this (relative to the diagonal, on average)
-/// from its rigid placement on the target is re-placed and continues.
-constexpr double REALIGN_TOLERANCE_REL = 1e-4;
 /// Rest shapes between the start and a checkpoint solved on the way to the checkpoint's equilibrium.
 constexpr int RESUME_STEPS = 4;
 /// Newton steps a line-search trial may take before the step is halved instead.
@@ -115,9 +107,9 @@ class AdjointDesign {
                 std::vector<double>(static_cast<size_t>(target.face_count()), options.thickness_mm)),
         m_solver(m_model, rigid_support(m_rest_mesh)),
         m_sensitivity(m_model, m_solver),
-        m_distance(target.vertices, target.faces, options.k_length, options.k_bending),
-        m_surface(target),
-        m_start_hinges(m_rest_mesh.vertices, target.faces, 0.0, REST_BENDING_WEIGHT * options.k_bending),
+        m_objective(target, m_rest_mesh, options, m_model),
+        m_distance(m_objective.distance()),
+        m_surface(m_objective.surface()),
         m_target_volume(enclosed_volume(target.vertices, target.faces)) {
     // Equilibria to 1e-6 of the force scale: the adjoint gradients are as good as at 1e-7 (same errors
     // on the bench) and a trial needs one Newton step less.
@@ -128,18 +120,6 @@ class AdjointDesign {
     m_rest_free.assign(static_cast<size_t>(3 * target.vertex_count()), true);
     for (int v : options.nozzle_vertices)
       for (int a = 0; a < 3; ++a) m_rest_free[static_cast<size_t>(3 * v + a)] = false;
-    // Rest-shape collisions: vertices closer than half a mean edge (eq. 24), costing one kd-tree pass
-    // per accepted iteration and nothing else while no pair is near.
-    SelfCollisionOptions collision;
-    collision.stiffness = 10.0 / std::pow(mean_edge_length(m_rest_mesh), 2);
-    collision.contact_distance_mm = 0.5 * mean_edge_length(m_rest_mesh);
-    m_collision = std::make_unique<SelfCollision>(m_rest_mesh, collision);
-    // Coplanar rest triangles leave the membrane forces blind to normal motion of their shared
-    // vertices (a null space of the rest-shape Hessian); only then does the rest-bending term (the
-    // bending part of eq. 18 against the start) take part.
-    m_rest_bending_active = (m_start_hinges.rest_angles().array().abs() < COPLANAR_HINGE_RAD).any();
-    const double diag = m_surface.bbox_diagonal_mm();
-    m_surface_weight = options.k_surface * m_distance.rest_lengths().sum() / (diag * diag * target.vertex_count());
   }
 
   DesignResult run() {
@@ -158,7 +138,7 @@ class AdjointDesign {
     DesignResult result;
     result.method = DesignMethod::AugmentedLagrangian;
     result.bbox_diag_mm = m_surface.bbox_diagonal_mm();
-    list_common_terms(result);
+    m_objective.list_common_terms(result, !m_options.nozzle_vertices.empty());
     Eigen::VectorXd rest = flat(m_rest_mesh.vertices);
     m_x = flat(scaled_about_centroid(m_rest_mesh.vertices, std::cbrt(m_target_volume / rest_volume(rest))));
     if (!initial_inflation(rest, result)) return finish(result, rest);
@@ -188,8 +168,9 @@ class AdjointDesign {
     auto lagrangian = [&](const Eigen::VectorXd& zz, Eigen::VectorXd* gradient) {
       const Eigen::VectorXd c = constraints(zz);
       Eigen::VectorXd surface_gradient;
-      const double value = m_distance.value(zz.tail(n)) + surface_term(zz.tail(n), gradient ? &surface_gradient : nullptr) +
-                           regularizer_value(zz.head(n)) - lambda.dot(c) + 0.5 * mu * c.squaredNorm();
+      const double value = m_distance.value(zz.tail(n)) +
+                           m_objective.surface_term(zz.tail(n), gradient ? &surface_gradient : nullptr) +
+                           m_objective.regularizer_value(zz.head(n)) - lambda.dot(c) + 0.5 * mu * c.squaredNorm();
       if (gradient) {
         const Eigen::VectorXd w = mu * c - lambda;
         Eigen::VectorXd distance_gradient;
@@ -197,7 +178,7 @@ class AdjointDesign {
         distance_gradient += surface_gradient;
         gradient->resize(2 * n);
         gradient->head(n) = m_sensitivity.mixed_product(zz.head(n), zz.tail(n), w, true);
-        add_regularizer_gradient(zz.head(n), gradient->head(n));
+        m_objective.add_regularizer_gradient(zz.head(n), gradient->head(n));
         gradient->tail(n) = distance_gradient + m_solver.stiffness_times(zz.tail(n), pressure, w);
         for (Eigen::Index c2 = 0; c2 < 2 * n; ++c2)
           if (!free[static_cast<size_t>(c2)]) (*gradient)[c2] = 0.0;
@@ -272,7 +253,7 @@ class AdjointDesign {
         if (!accepted || gradient.norm() <= inner_tolerance) break;
       }
       if (result.stop != DesignStop::IterationLimit) break;
-      update_max_volume_term(z.head(n), start_distance, result);
+      m_objective.update_max_volume_term(z.head(n), start_distance, result);
       const Eigen::VectorXd c = constraints(z);
       const double new_norm = c.norm();
       if (new_norm <= 0.25 * constraint_norm || new_norm <= 1e-6 * force_scale) {
@@ -303,14 +284,6 @@ class AdjointDesign {
     if (!m_last_report.converged)
       result.message += "; the final rest shape did not reach equilibrium (" + m_last_report.message + ")";
     return finish(result, rest);
-  }
-
-  /// Once a rest region has turned inside out, the maximum-volume term (paper sec. 5.2) joins the
-  /// objective, weighted so that a 1% volume change is worth 1% of the start's E_dist.
-  void update_max_volume_term(const Eigen::VectorXd& rest, double start_distance, DesignResult& result) {
-    if (m_max_volume_weight > 0.0 || inverted_hinges(rest) == 0) return;
-    m_max_volume_weight = start_distance / rest_volume(flat(m_rest_mesh.vertices));
-    result.active_terms.push_back("max_volume");
   }
 
   /// Gauss-Newton Hessian of the augmented Lagrangian over z = (rest, x): H_dist^GN(x) on the x block,
@@ -349,9 +322,9 @@ class AdjointDesign {
     Eigen::SparseMatrix<double> hessian = mu * Eigen::SparseMatrix<double>(jacobian.transpose() * jacobian);
     std::vector<Eigen::Triplet<double>> objective_entries;
     m_distance.hessian_triplets(z.tail(n), objective_entries, DistanceHessian::GaussNewton, static_cast<int>(n));
-    if (m_rest_bending_active)
-      m_start_hinges.hessian_triplets(z.head(n), objective_entries, DistanceHessian::GaussNewton, 0);
-    add_surface_hessian(z.tail(n), objective_entries, static_cast<int>(n));
+    if (m_objective.rest_bending_active())
+      m_objective.start_hinges().hessian_triplets(z.head(n), objective_entries, DistanceHessian::GaussNewton, 0);
+    m_objective.add_surface_hessian(z.tail(n), objective_entries, static_cast<int>(n));
     std::vector<Eigen::Triplet<double>> kept;
     kept.reserve(objective_entries.size());
     for (const auto& entry : objective_entries)
@@ -370,7 +343,7 @@ class AdjointDesign {
     DesignResult result;
     result.method = DesignMethod::Adjoint;
     result.bbox_diag_mm = m_surface.bbox_diagonal_mm();
-    list_common_terms(result);
+    m_objective.list_common_terms(result, !m_options.nozzle_vertices.empty());
     result.active_terms.push_back("fixed_rest_volume");
 
     // Start: inflate the downscaled target to the target's volume; that fixes the inflation.
@@ -397,7 +370,7 @@ class AdjointDesign {
       debug_time("resumed from the checkpoint");
     }
     Eigen::VectorXd gradient;
-    double objective = objective_value(rest, m_x);
+    double objective = m_objective.value(rest, m_x);
     if (!objective_gradient(rest, gradient)) {
       stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized at the start");
       return finish(result, rest);
@@ -457,7 +430,7 @@ class AdjointDesign {
           if (stopped()) break;
           continue;
         }
-        trial_objective = objective_value(trial_rest, trial_x);
+        trial_objective = m_objective.value(trial_rest, trial_x);
         if (trial_objective <= objective + 1e-4 * t * slope) {
           accepted = true;
           break;
@@ -490,15 +463,10 @@ class AdjointDesign {
       rest = trial_rest;
       m_x = trial_x;
       m_pressure = trial_pressure;
-      const bool was_colliding = m_collision->any_active();
-      const bool colliding = m_collision->update(rest) > 0;
-      if (colliding && !m_collision_seen) {
-        m_collision_seen = true;
-        result.active_terms.push_back("collision");
-      }
+      const bool collisions_changed = m_objective.update_collisions(rest, result);
       Eigen::VectorXd new_gradient;
       // The line search already evaluated this point; only a changed set of colliding pairs alters it.
-      objective = colliding || was_colliding ? objective_value(rest, m_x) : trial_objective;
+      objective = collisions_changed ? m_objective.value(rest, m_x) : trial_objective;
       if (!objective_gradient(rest, new_gradient)) {
         stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized");
         break;
@@ -538,12 +506,12 @@ class AdjointDesign {
       } else if (objective < (1.0 - STALL_OBJECTIVE_DECREASE) * stall_objective) {
         stall_iteration = iteration;  // the error may rise for a while as the objective reshapes the balloon
         stall_objective = objective;
-      } else if (iteration - stall_iteration >= STALL_ITERATIONS && realign_inflated_shape(result.bbox_diag_mm)) {
+      } else if (iteration - stall_iteration >= STALL_ITERATIONS && m_objective.realign(m_x)) {
         // The pinned coordinates held the shape where the start put it; re-placed on the target, the
         // surface term can pull again. A rigid motion of an equilibrium is one: only the gauge changed.
         memory.clear();
         stall_iteration = iteration;
-        objective = objective_value(rest, m_x);
+        objective = m_objective.value(rest, m_x);
         stall_objective = objective;
         if (!objective_gradient(rest, gradient)) {
           stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized");
@@ -596,32 +564,10 @@ class AdjointDesign {
     return start;
   }
 
-  /// Hinges of `rest` whose dihedral angle moved more than a right angle from the start's: a region
-  /// turned inside out (mirrored through its planar rim), which inflates to nearly the same shape.
-  int inverted_hinges(const Eigen::VectorXd& rest) const {
-    const auto& edges = m_start_hinges.edges();
-    const Eigen::VectorXd& start_angles = m_start_hinges.rest_angles();
-    int count = 0;
-    for (int h = 0; h < m_start_hinges.hinge_count(); ++h) {
-      const double angle = dihedral_angle(rest.segment<3>(3 * edges(h, 0)), rest.segment<3>(3 * edges(h, 1)),
-                                          rest.segment<3>(3 * edges(h, 2)), rest.segment<3>(3 * edges(h, 3)));
-      if (std::abs(angle - start_angles[h]) > 0.5 * M_PI) ++count;
-    }
-    return count;
-  }
-
   static std::vector<bool> rigid_support(const TriMesh& mesh) {
     std::vector<bool> fixed(static_cast<size_t>(3 * mesh.vertex_count()), false);
     for (int c : rigid_support_coordinates(mesh.vertices)) fixed[static_cast<size_t>(c)] = true;
     return fixed;
-  }
-
-  static double mean_edge_length(const TriMesh& mesh) {
-    double total = 0.0;
-    for (int f = 0; f < mesh.face_count(); ++f)
-      for (int k = 0; k < 3; ++k)
-        total += (mesh.vertices.row(mesh.faces(f, k)) - mesh.vertices.row(mesh.faces(f, (k + 1) % 3))).norm();
-    return total / (3.0 * std::max(1, mesh.face_count()));
   }
 
   /// Restores the rest volume after a step, moving only free vertices along the volume gradient.
@@ -727,107 +673,13 @@ class AdjointDesign {
     return true;
   }
 
-  double objective_value(const Eigen::VectorXd& rest, const Eigen::VectorXd& x) const {
-    return m_distance.value(x) + surface_term(x, nullptr) + regularizer_value(rest);
-  }
-
-  /// E_surf = k_s L mean_i (d_i / diag)^2: the squared point-to-surface distances of the inflated
-  /// vertices (the error the result reports), scaled like E_dist per mm of reference edge (L = total
-  /// reference edge length, mm). Its gradient is 2 w (x_i - c_i) with c_i the closest target point
-  /// (the derivative of a squared distance to a surface, wherever the closest point is unique).
-  double surface_term(const Eigen::VectorXd& x, Eigen::VectorXd* gradient) const {
-    if (m_surface_weight <= 0.0) {
-      if (gradient) gradient->setZero(x.size());
-      return 0.0;
-    }
-    // x is in the target's frame: the start's inflation is aligned onto the target, and the 6 pinned
-    // coordinates keep it there.
-    const Positions points = unflatten(x);
-    Positions closest;
-    Eigen::VectorXd distances;
-    m_surface.closest_points(points, closest, &distances);
-    if (gradient) *gradient = 2.0 * m_surface_weight * flat(Positions(points - closest));
-    return m_surface_weight * distances.squaredNorm();
-  }
-
-  /// Moves the inflated shape rigidly onto the target (vertex correspondence) when that moves it by
-  /// more than REALIGN_TOLERANCE_REL of the diagonal on average, and says whether it did. Only E_surf
-  /// cares where the shape sits; the pinned coordinates otherwise keep the start's placement.
-  bool realign_inflated_shape(double bbox_diag_mm) {
-    if (m_surface_weight <= 0.0) return false;
-    const Positions current = unflatten(m_x);
-    const Positions aligned = rigid_align_to(current, m_target.vertices);
-    if ((aligned - current).rowwise().norm().mean() <= REALIGN_TOLERANCE_REL * bbox_diag_mm) return false;
-    m_x = flat(aligned);
-    return true;
-  }
-
-  /// Gauss-Newton Hessian of E_surf, point-to-plane: 2 w n n^T per vertex with n the normal of the
-  /// target triangle closest to it (sliding along the target costs nothing; E_dist governs that).
-  void add_surface_hessian(const Eigen::VectorXd& x, std::vector<Eigen::Triplet<double>>& triplets,
-                           int dof_offset) const {
-    if (m_surface_weight <= 0.0) return;
-    const Positions points = unflatten(x);
-    Positions closest;
-    Eigen::VectorXi faces;
-    m_surface.closest_points(points, closest, nullptr, &faces);
-    for (Eigen::Index v = 0; v < points.rows(); ++v) {
-      const Eigen::Vector3d a = m_target.vertices.row(m_target.faces(faces[v], 0));
-      const Eigen::Vector3d b = m_target.vertices.row(m_target.faces(faces[v], 1));
-      const Eigen::Vector3d c = m_target.vertices.row(m_target.faces(faces[v], 2));
-      const Eigen::Vector3d normal = (b - a).cross(c - a).normalized();
-      if (!normal.allFinite()) continue;
-      const Eigen::Matrix3d block = 2.0 * m_surface_weight * normal * normal.transpose();
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-          triplets.emplace_back(dof_offset + 3 * static_cast<int>(v) + i, dof_offset + 3 * static_cast<int>(v) + j,
-                                block(i, j));
-    }
-  }
-
-  /// The rest-shape terms that are active: collisions, rest bending, maximum volume.
-  double regularizer_value(const Eigen::VectorXd& rest) const {
-    double value = 0.0;
-    if (m_collision->any_active()) value += m_collision->value(rest);
-    if (m_rest_bending_active) value += m_start_hinges.value(rest);
-    if (m_max_volume_weight > 0.0) value -= m_max_volume_weight * rest_volume(rest);
-    return value;
-  }
-
-  /// Adds the gradient of regularizer_value to `gradient`.
-  void add_regularizer_gradient(const Eigen::VectorXd& rest, Eigen::Ref<Eigen::VectorXd> gradient) const {
-    Eigen::VectorXd part;
-    if (m_collision->any_active()) {
-      m_collision->gradient(rest, part);
-      gradient += part;
-    }
-    if (m_rest_bending_active) {
-      m_start_hinges.gradient(rest, part);
-      gradient += part;
-    }
-    if (m_max_volume_weight > 0.0) gradient -= m_max_volume_weight * m_model.volume_gradient(rest);
-  }
-
-  /// Active terms every method shares (the method adds its own).
-  void list_common_terms(DesignResult& result) const {
-    result.active_terms.push_back("distance");
-    if (m_surface_weight > 0.0) result.active_terms.push_back("surface");
-    if (!m_options.nozzle_vertices.empty()) result.active_terms.push_back("nozzle");
-    if (m_rest_bending_active) result.active_terms.push_back("rest_bending");
-  }
-
   /// d objective / d rest through the adjoint of the bordered equilibrium system at (m_x, m_pressure):
   /// [K -v; -v^T 0] [lambda; mu] = [dE/dx; 0], gradient = -(d grad_x W / d rest)^T lambda.
   bool objective_gradient(const Eigen::VectorXd& rest, Eigen::VectorXd& gradient) {
     m_model.set_rest_positions(unflatten(rest));
     if (!m_sensitivity.prepare(rest, m_x, m_pressure)) return false;
-    Eigen::VectorXd distance_gradient;
-    m_distance.gradient(m_x, distance_gradient);
-    Eigen::VectorXd surface_gradient;
-    surface_term(m_x, &surface_gradient);
-    distance_gradient += surface_gradient;
-    gradient = m_sensitivity.gradient(distance_gradient);
-    add_regularizer_gradient(rest, gradient);
+    gradient = m_sensitivity.gradient(m_objective.shape_gradient(m_x));
+    m_objective.add_regularizer_gradient(rest, gradient);
     for (int c = 0; c < gradient.size(); ++c)
       if (!m_rest_free[static_cast<size_t>(c)]) gradient[c] = 0.0;
     // The rest volume stays at target volume / volume ratio: with the inflated volume fixed, a uniform
@@ -846,7 +698,7 @@ class AdjointDesign {
   void build_preconditioner() {
     std::vector<Eigen::Triplet<double>> entries;
     m_distance.hessian_triplets(m_x, entries, DistanceHessian::GaussNewton);
-    add_surface_hessian(m_x, entries, 0);
+    m_objective.add_surface_hessian(m_x, entries, 0);
     Eigen::SparseMatrix<double> hessian(m_x.size(), m_x.size());
     hessian.setFromTriplets(entries.begin(), entries.end());
     const double shift = 1e-3 * hessian.diagonal().mean();
@@ -951,15 +803,10 @@ class AdjointDesign {
   fem::BalloonModel m_model;
   EquilibriumSolver m_solver;
   AdjointSensitivity m_sensitivity;  ///< dx/drest at the current equilibrium: the gradient and the predictor
-  DistanceEnergy m_distance;
-  SurfaceDistance m_surface;
-  std::unique_ptr<SelfCollision> m_collision;
+  DesignObjective m_objective;
+  const DistanceEnergy& m_distance;
+  const SurfaceDistance& m_surface;
   std::unique_ptr<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>>> m_preconditioner;
-  bool m_collision_seen = false;
-  DistanceEnergy m_start_hinges;  ///< the start's hinge angles; with k_length 0 it is the rest-bending term
-  bool m_rest_bending_active = false;
-  double m_surface_weight = 0.0;  ///< w of E_surf = w sum_i d_i^2 (mm^-1); 0 when k_surface is 0
-  double m_max_volume_weight = 0.0;  ///< alm: weight of -V(rest) once a region turned inside out (mm^-2)
   double m_target_volume;
   std::vector<bool> m_rest_free;
   NewtonSettings m_settings;
