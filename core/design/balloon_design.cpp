@@ -12,6 +12,7 @@
 #include <optional>
 
 #include "design/adjoint_sensitivity.hpp"
+#include "design/design_driver.hpp"
 #include "design/design_objective.hpp"
 #include "design/distance_energy.hpp"
 #include "design/surface_distance.hpp"
@@ -49,7 +50,6 @@ Result<DesignMethod> parse_design_method(const std::string& name) {
 
 namespace {
 
-constexpr double MPA_PER_KPA = 1e-3;
 /// The adjoint method stops when neither the average surface error (what the maker sees) nor the
 /// objective has improved by STALL_IMPROVEMENT (relative) in STALL_ITERATIONS iterations, or when the
 /// average error is below MATCH_TOLERANCE_REL of the target's diagonal (0.01 mm on 100 mm, far below
@@ -62,14 +62,6 @@ constexpr double STALL_OBJECTIVE_DECREASE = 0.1;
 constexpr double MATCH_TOLERANCE_REL = 1e-4;
 /// First-order optimality: the design gradient below this fraction of its value at the start.
 constexpr double OPTIMALITY_TOLERANCE = 1e-6;
-/// Rest shapes between the start and a checkpoint solved on the way to the checkpoint's equilibrium.
-constexpr int RESUME_STEPS = 4;
-/// Newton steps a line-search trial may take before the step is halved instead.
-constexpr int TRIAL_NEWTON_ITERATIONS = 10;
-
-double now_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 
 /// A fraction as a short human string: 0.01 -> "1%", 1e-4 -> "1e-04".
 std::string format_fraction(double fraction) {
@@ -86,299 +78,56 @@ std::string format_ratio(double ratio) {
   return text;
 }
 
-Positions scaled_about_centroid(const Positions& points, double scale) {
-  const Eigen::RowVector3d center = points.colwise().mean();
-  Positions scaled = (points.rowwise() - center) * scale;
-  scaled.rowwise() += center;
-  return scaled;
-}
-
 /// Reduced-space design: the inflated shape x is the volume-controlled equilibrium of the rest shape,
 /// warm-started from the previous one; the gradient of E_dist(x(rest)) comes from one adjoint solve of
 /// the bordered equilibrium system with the Hessian factorized at the equilibrium; L-BFGS outside.
-class AdjointDesign {
+class ReducedSpaceDesign {
  public:
-  AdjointDesign(const TriMesh& target, const DesignOptions& options)
-      : m_target(target),
-        m_options(options),
-        m_start(now_s()),
-        m_rest_mesh(start_shape(target, options)),
-        m_model(m_rest_mesh, options.material,
-                std::vector<double>(static_cast<size_t>(target.face_count()), options.thickness_mm)),
-        m_solver(m_model, rigid_support(m_rest_mesh)),
-        m_sensitivity(m_model, m_solver),
-        m_objective(target, m_rest_mesh, options, m_model),
-        m_distance(m_objective.distance()),
-        m_surface(m_objective.surface()),
-        m_target_volume(enclosed_volume(target.vertices, target.faces)) {
-    // Equilibria to 1e-6 of the force scale: the adjoint gradients are as good as at 1e-7 (same errors
-    // on the bench) and a trial needs one Newton step less.
-    m_settings.relative_tolerance = 1e-6;
-    m_settings.max_iterations = 60;
-    m_settings.cancel = options.cancel;
-    m_settings.deadline_s = options.max_time_s > 0 ? m_start + options.max_time_s : 0.0;
-    m_rest_free.assign(static_cast<size_t>(3 * target.vertex_count()), true);
-    for (int v : options.nozzle_vertices)
-      for (int a = 0; a < 3; ++a) m_rest_free[static_cast<size_t>(3 * v + a)] = false;
-  }
+  explicit ReducedSpaceDesign(DesignDriver& driver)
+      : m_driver(driver),
+        m_target(driver.target()),
+        m_options(driver.options()),
+        m_model(driver.model()),
+        m_solver(driver.solver()),
+        m_sensitivity(driver.sensitivity()),
+        m_objective(driver.objective()),
+        m_distance(driver.objective().distance()),
+        m_surface(driver.objective().surface()),
+        m_settings(driver.settings()),
+        m_rest_free(driver.rest_free()),
+        m_target_volume(driver.target_volume()),
+        m_x(driver.x()),
+        m_pressure(driver.pressure()),
+        m_last_report(driver.last_report()) {}
 
   DesignResult run() {
-    return m_options.method == DesignMethod::AugmentedLagrangian ? run_augmented_lagrangian() : run_adjoint();
-  }
-
- private:
-  /// The paper's method (sec. 5.2): minimise E_dist(x) + R(rest) - lambda^T C + mu/2 |C|^2 over rest and
-  /// inflated positions together, C = grad_x W(x; rest) - p grad V(x) the nodal force balance at the
-  /// start's pressure p (R: the active regularizers). Multipliers update by eq. 22 when |C| fell to a
-  /// quarter, else mu grows tenfold. The inner solve is Gauss-Newton with Levenberg-Marquardt damping and
-  /// a backtracking line search: the Hessian is approximated by H_dist^GN + mu J^T J with J = [dC/drest,
-  /// dC/dx] = [M, K] (the term lambda^T d2C is dropped), factorized by CHOLMOD on a pattern analysed once.
-  /// At the end the rest shape is inflated properly, so the reported errors are a true equilibrium's.
-  DesignResult run_augmented_lagrangian() {
-    DesignResult result;
-    result.method = DesignMethod::AugmentedLagrangian;
-    result.bbox_diag_mm = m_surface.bbox_diagonal_mm();
-    m_objective.list_common_terms(result, !m_options.nozzle_vertices.empty());
-    Eigen::VectorXd rest = flat(m_rest_mesh.vertices);
-    m_x = flat(scaled_about_centroid(m_rest_mesh.vertices, std::cbrt(m_target_volume / rest_volume(rest))));
-    if (!initial_inflation(rest, result)) return finish(result, rest);
-    const SurfaceDistanceStats baseline = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
-    result.baseline_avg_error_mm = baseline.avg_mm;
-    result.baseline_max_error_mm = baseline.max_mm;
-    record(result, 0, baseline, rest);
-    remember_if_best(rest, baseline.avg_mm);
-
-    const Eigen::Index n = rest.size();
-    std::vector<bool> free(static_cast<size_t>(2 * n));
-    for (Eigen::Index c = 0; c < n; ++c) {
-      free[static_cast<size_t>(c)] = m_rest_free[static_cast<size_t>(c)];
-      free[static_cast<size_t>(n + c)] = m_solver.assembly().free_index(static_cast<int>(c)) >= 0;
-    }
-    const double pressure = m_pressure;
-    const double force_scale = m_solver.force_scale(m_x, pressure);
-    const double start_distance = std::max(m_distance.value(m_x), 1e-6 * result.bbox_diag_mm);
-    double mu = 10.0 * start_distance / (force_scale * force_scale);
-    Eigen::VectorXd lambda = Eigen::VectorXd::Zero(n);
-    Eigen::VectorXd z(2 * n);
-    z << rest, m_x;
-    auto constraints = [&](const Eigen::VectorXd& zz) {
-      m_model.set_rest_positions(unflatten(zz.head(n)));
-      return m_solver.residual(zz.tail(n), pressure);
-    };
-    auto lagrangian = [&](const Eigen::VectorXd& zz, Eigen::VectorXd* gradient) {
-      const Eigen::VectorXd c = constraints(zz);
-      Eigen::VectorXd surface_gradient;
-      const double value = m_distance.value(zz.tail(n)) +
-                           m_objective.surface_term(zz.tail(n), gradient ? &surface_gradient : nullptr) +
-                           m_objective.regularizer_value(zz.head(n)) - lambda.dot(c) + 0.5 * mu * c.squaredNorm();
-      if (gradient) {
-        const Eigen::VectorXd w = mu * c - lambda;
-        Eigen::VectorXd distance_gradient;
-        m_distance.gradient(zz.tail(n), distance_gradient);
-        distance_gradient += surface_gradient;
-        gradient->resize(2 * n);
-        gradient->head(n) = m_sensitivity.mixed_product(zz.head(n), zz.tail(n), w, true);
-        m_objective.add_regularizer_gradient(zz.head(n), gradient->head(n));
-        gradient->tail(n) = distance_gradient + m_solver.stiffness_times(zz.tail(n), pressure, w);
-        for (Eigen::Index c2 = 0; c2 < 2 * n; ++c2)
-          if (!free[static_cast<size_t>(c2)]) (*gradient)[c2] = 0.0;
-      }
-      return value;
-    };
-
-    Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> factorization;
-    bool analysed = false;
-    double damping = 0.0;  // Levenberg-Marquardt, relative to the mean diagonal
-    int iteration = 0;
-    double constraint_norm = constraints(z).norm();
-    stop_with(result, DesignStop::IterationLimit, "iteration limit reached");
-    for (int outer = 0; outer < 30 && iteration < m_options.max_iterations; ++outer) {
-      Eigen::VectorXd gradient;
-      double value = lagrangian(z, &gradient);
-      const double inner_tolerance = 1e-3 * gradient.norm();
-      for (int inner = 0; inner < 20 && iteration < m_options.max_iterations; ++inner) {
-        if (m_options.cancel && m_options.cancel->cancelled()) stop_with(result, DesignStop::Cancelled, "cancelled");
-        if (m_settings.deadline_s > 0 && now_s() > m_settings.deadline_s)
-          stop_with(result, DesignStop::TimeLimit, "time limit reached");
-        if (result.stop != DesignStop::IterationLimit) break;
-        ++iteration;
-        Eigen::SparseMatrix<double> hessian = gauss_newton_hessian(z, pressure, mu, free);
-        const double diagonal = hessian.diagonal().mean();
-        if (damping == 0.0) damping = 1e-6;
-        Eigen::VectorXd direction;
-        for (int attempt = 0; attempt < 8; ++attempt) {
-          Eigen::SparseMatrix<double> damped = hessian;
-          for (Eigen::Index c = 0; c < damped.rows(); ++c) damped.coeffRef(c, c) += damping * diagonal;
-          if (!analysed) {
-            factorization.analyzePattern(damped);
-            analysed = true;
-          }
-          factorization.factorize(damped);
-          if (factorization.info() == Eigen::Success) {
-            direction = -factorization.solve(gradient);
-            if (direction.allFinite() && direction.dot(gradient) < 0.0) break;
-          }
-          direction.resize(0);
-          damping *= 10.0;
-        }
-        if (direction.size() == 0) {
-          stop_with(result, DesignStop::Stalled, "stalled: the Gauss-Newton system could not be factorized");
-          break;
-        }
-        // Trust region: no vertex moves more than 2% of the target's size per step.
-        const double largest = std::max(unflatten(direction.head(n)).rowwise().norm().maxCoeff(),
-                                        unflatten(direction.tail(n)).rowwise().norm().maxCoeff());
-        double t = std::min(1.0, 0.02 * result.bbox_diag_mm / std::max(largest, 1e-300));
-        const double slope = direction.dot(gradient);
-        bool accepted = false;
-        for (int k = 0; k < 20 && !accepted; ++k) {
-          const Eigen::VectorXd trial = z + t * direction;
-          const double trial_value = lagrangian(trial, nullptr);
-          if (std::isfinite(trial_value) && trial_value <= value + 1e-4 * t * slope) {
-            z = trial;
-            value = lagrangian(z, &gradient);
-            accepted = true;
-          } else {
-            t *= 0.5;
-          }
-        }
-        damping = accepted && t == 1.0 ? std::max(1e-9, damping * 0.3) : damping * 10.0;
-        if (accepted) {
-          m_x = z.tail(n);
-          m_pressure = pressure;
-          m_last_report.residual_norm = constraints(z).norm();
-          const SurfaceDistanceStats stats = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
-          record(result, iteration, stats, z.head(n));
-        }
-        if (!accepted || gradient.norm() <= inner_tolerance) break;
-      }
-      if (result.stop != DesignStop::IterationLimit) break;
-      m_objective.update_max_volume_term(z.head(n), start_distance, result);
-      const Eigen::VectorXd c = constraints(z);
-      const double new_norm = c.norm();
-      if (new_norm <= 0.25 * constraint_norm || new_norm <= 1e-6 * force_scale) {
-        lambda -= mu * c;  // eq. 22
-        constraint_norm = new_norm;
-      } else {
-        mu *= 10.0;
-      }
-      lagrangian(z, &gradient);
-      if (new_norm <= 1e-6 * force_scale && gradient.norm() < 1e-4 * force_scale) {
-        stop_with(result, DesignStop::Optimal,
-                  "optimal: force residual below 1e-6 and Lagrangian gradient below 1e-4 of the force scale");
-        break;
-      }
-    }
-    result.iterations = iteration;
-    // The ALM iterate only nearly balances the forces: report the true equilibrium of its rest shape.
-    rest = z.head(n);
-    Eigen::VectorXd x = z.tail(n);
-    double inflated_pressure = pressure;
-    NewtonSettings settings = m_settings;
-    settings.deadline_s = 0.0;
-    m_model.set_rest_positions(unflatten(rest));
-    m_last_report = m_solver.solve_volume(x, inflated_pressure, m_target_volume, settings);
-    m_x = x;
-    m_pressure = inflated_pressure;
-    m_final_equilibrium = m_last_report.converged;
-    if (!m_last_report.converged)
-      result.message += "; the final rest shape did not reach equilibrium (" + m_last_report.message + ")";
-    return finish(result, rest);
-  }
-
-  /// Gauss-Newton Hessian of the augmented Lagrangian over z = (rest, x): H_dist^GN(x) on the x block,
-  /// the rest-bending Gauss-Newton block when active, plus mu J^T J with J = [M, K]. Fixed coordinates
-  /// get zero rows and columns (the damping makes them identity).
-  Eigen::SparseMatrix<double> gauss_newton_hessian(const Eigen::VectorXd& z, double pressure, double mu,
-                                                   const std::vector<bool>& free) const {
-    const Eigen::Index n = z.size() / 2;
-    const Faces& faces = m_target.faces;
-    std::vector<Eigen::Triplet<double>> jacobian_entries;
-    jacobian_entries.reserve(static_cast<size_t>(faces.rows()) * 162);
-    const Eigen::VectorXd rest = z.head(n), x = z.tail(n);
-    for (int f = 0; f < faces.rows(); ++f) {
-      const fem::Vector9d rest_corners = m_model.corners(rest, f), x_corners = m_model.corners(x, f);
-      const fem::Matrix9d mixed =
-          fem::membrane_mixed_derivative(m_model.material(), m_model.thickness(f), rest_corners, x_corners);
-      double energy = 0.0;
-      fem::Vector9d element_gradient;
-      fem::Matrix9d stiffness;
-      fem::membrane_energy_gradient_hessian(m_model.material(), m_model.thickness(f),
-                                            fem::make_rest_triangle(rest_corners), x_corners, energy,
-                                            element_gradient, stiffness);
-      stiffness -= pressure * fem::triangle_volume_hessian(x_corners);
-      for (int i = 0; i < 9; ++i) {
-        const Eigen::Index row = 3 * faces(f, i / 3) + i % 3;
-        if (!free[static_cast<size_t>(n + row)]) continue;
-        for (int j = 0; j < 9; ++j) {
-          const Eigen::Index column = 3 * faces(f, j / 3) + j % 3;
-          if (free[static_cast<size_t>(column)]) jacobian_entries.emplace_back(row, column, mixed(i, j));
-          if (free[static_cast<size_t>(n + column)]) jacobian_entries.emplace_back(row, n + column, stiffness(i, j));
-        }
-      }
-    }
-    Eigen::SparseMatrix<double> jacobian(n, 2 * n);
-    jacobian.setFromTriplets(jacobian_entries.begin(), jacobian_entries.end());
-    Eigen::SparseMatrix<double> hessian = mu * Eigen::SparseMatrix<double>(jacobian.transpose() * jacobian);
-    std::vector<Eigen::Triplet<double>> objective_entries;
-    m_distance.hessian_triplets(z.tail(n), objective_entries, DistanceHessian::GaussNewton, static_cast<int>(n));
-    if (m_objective.rest_bending_active())
-      m_objective.start_hinges().hessian_triplets(z.head(n), objective_entries, DistanceHessian::GaussNewton, 0);
-    m_objective.add_surface_hessian(z.tail(n), objective_entries, static_cast<int>(n));
-    std::vector<Eigen::Triplet<double>> kept;
-    kept.reserve(objective_entries.size());
-    for (const auto& entry : objective_entries)
-      if (free[static_cast<size_t>(entry.row())] && free[static_cast<size_t>(entry.col())]) kept.push_back(entry);
-    Eigen::SparseMatrix<double> objective(2 * n, 2 * n);
-    objective.setFromTriplets(kept.begin(), kept.end());
-    hessian += objective;
-    // Every diagonal entry exists, so the damping adds to the pattern the analysis saw.
-    Eigen::SparseMatrix<double> identity(2 * n, 2 * n);
-    identity.setIdentity();
-    hessian += 0.0 * identity;
-    return hessian;
-  }
-
-  DesignResult run_adjoint() {
-    DesignResult result;
-    result.method = DesignMethod::Adjoint;
-    result.bbox_diag_mm = m_surface.bbox_diagonal_mm();
-    m_objective.list_common_terms(result, !m_options.nozzle_vertices.empty());
+    DesignResult result = m_driver.begin(DesignMethod::Adjoint);
     result.active_terms.push_back("fixed_rest_volume");
 
     // Start: inflate the downscaled target to the target's volume; that fixes the inflation.
-    Eigen::VectorXd rest = flat(m_rest_mesh.vertices);
-    m_x = flat(scaled_about_centroid(m_rest_mesh.vertices, std::cbrt(m_target_volume / rest_volume(rest))));
-    m_pressure = 0.0;
-    if (!initial_inflation(rest, result)) return finish(result, rest);
-    debug_time("initial inflation");
-    const SurfaceDistanceStats baseline = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
-    result.baseline_avg_error_mm = baseline.avg_mm;
-    result.baseline_max_error_mm = baseline.max_mm;
-    record(result, 0, baseline, rest);
-    remember_if_best(rest, baseline.avg_mm);
-    debug_time("baseline error");
+    Eigen::VectorXd rest = flat(m_driver.start().vertices);
+    if (!m_driver.inflate_start(rest, result)) return m_driver.finish(result, rest);
     int first_iteration = 1;
-    double stall_reference = baseline.avg_mm;  // best surface error at the last real improvement (mm)
-    if (m_options.resume && resume_from(*m_options.resume, rest)) {
+    double stall_reference = *result.baseline_avg_error_mm;  // best surface error at the last real improvement (mm)
+    if (m_options.resume && m_driver.resume_from(*m_options.resume, rest)) {
       result.resumed_from_iteration = m_options.resume->iteration;
       first_iteration = m_options.resume->iteration + 1;
       const SurfaceDistanceStats resumed = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
-      record(result, m_options.resume->iteration, resumed, rest);
-      remember_if_best(rest, resumed.avg_mm);
+      m_driver.record(result, m_options.resume->iteration, resumed, rest);
+      m_driver.remember_if_best(rest, resumed.avg_mm);
       stall_reference = resumed.avg_mm;
-      debug_time("resumed from the checkpoint");
+      m_driver.debug_time("resumed from the checkpoint");
     }
     Eigen::VectorXd gradient;
     double objective = m_objective.value(rest, m_x);
     if (!objective_gradient(rest, gradient)) {
       stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized at the start");
-      return finish(result, rest);
+      return m_driver.finish(result, rest);
     }
     const double initial_gradient_norm = gradient.norm();
     const double initial_objective = objective;
     build_preconditioner();
-    debug_time("first gradient and preconditioner");
+    m_driver.debug_time("first gradient and preconditioner");
     std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> memory;  // (s, y) pairs for L-BFGS
     int small_decreases = 0;
     double stall_objective = objective;         // objective at the last real improvement of either
@@ -391,7 +140,7 @@ class AdjointDesign {
         stop_with(result, DesignStop::Cancelled, "cancelled");
         break;
       }
-      if (m_settings.deadline_s > 0 && now_s() > m_settings.deadline_s) {
+      if (m_settings.deadline_s > 0 && design_clock_s() > m_settings.deadline_s) {
         stop_with(result, DesignStop::TimeLimit, "time limit reached");
         break;
       }
@@ -419,15 +168,15 @@ class AdjointDesign {
       Eigen::VectorXd trial_rest, trial_x;
       double trial_pressure = 0.0, trial_objective = 0.0;
       for (int k = 0; k < 12; ++k, t *= 0.5) {
-        trial_rest = keep_rest_volume(rest + t * direction, rest_volume(rest));
+        trial_rest = m_driver.keep_rest_volume(rest + t * direction, m_driver.rest_volume(rest));
         trial_x = m_x + t * response;
         trial_pressure = m_pressure + t * pressure_response;
-        const bool balanced = equilibrium(trial_rest, trial_x, trial_pressure);
+        const bool balanced = m_driver.equilibrium(trial_rest, trial_x, trial_pressure);
         if (std::getenv("BALLOON_DEBUG_DESIGN"))
           std::fprintf(stderr, "  it %d trial %d t=%.3g newton %d %s (%.2f s)\n", iteration, k, t,
-                       m_last_report.iterations, m_last_report.message.c_str(), now_s() - m_start);
+                       m_last_report.iterations, m_last_report.message.c_str(), design_clock_s() - m_driver.start_time());
         if (!balanced) {
-          if (stopped()) break;
+          if (m_driver.stopped()) break;
           continue;
         }
         trial_objective = m_objective.value(trial_rest, trial_x);
@@ -437,7 +186,7 @@ class AdjointDesign {
         }
       }
       if (!accepted) {
-        if (stopped()) {
+        if (m_driver.stopped()) {
           stop_with(result, m_last_report.message == "cancelled" ? DesignStop::Cancelled : DesignStop::TimeLimit,
                     m_last_report.message);
           break;
@@ -471,7 +220,7 @@ class AdjointDesign {
         stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized");
         break;
       }
-      debug_time("gradient");
+      m_driver.debug_time("gradient");
       const Eigen::VectorXd change = new_gradient - gradient;
       if (step.dot(change) > 1e-12 * step.norm() * change.norm()) {
         memory.emplace_back(step, change);
@@ -479,10 +228,10 @@ class AdjointDesign {
       }
       gradient = new_gradient;
       const SurfaceDistanceStats stats = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
-      record(result, iteration, stats, rest);
-      remember_if_best(rest, stats.avg_mm);
+      m_driver.record(result, iteration, stats, rest);
+      m_driver.remember_if_best(rest, stats.avg_mm);
       result.iterations = iteration;
-      debug_time("surface error");
+      m_driver.debug_time("surface error");
       const double relative_decrease = -t * slope / std::max(initial_objective, 1e-300);
       small_decreases = relative_decrease < 1e-7 ? small_decreases + 1 : 0;
       if (stats.avg_rel < MATCH_TOLERANCE_REL) {
@@ -524,155 +273,11 @@ class AdjointDesign {
         break;
       }
     }
-    // E_dist and the surface error mostly fall together; where they part, hand back the design with
-    // the smallest average surface error seen (the log still shows every iterate).
-    if (m_best_error < std::numeric_limits<double>::infinity() && m_best_rest.size() == rest.size()) {
-      const double current = m_surface.aligned_stats(unflatten(m_x), m_target.vertices).avg_mm;
-      if (m_best_error < current) {
-        rest = m_best_rest;
-        m_x = m_best_x;
-        m_pressure = m_best_pressure;
-      }
-    }
-    return finish(result, rest);
+    m_driver.restore_best(rest);
+    return m_driver.finish(result, rest);
   }
 
  private:
-  /// With BALLOON_DEBUG_DESIGN set, prints the time since the start after `what` (stderr).
-  void debug_time(const char* what) const {
-    if (std::getenv("BALLOON_DEBUG_DESIGN")) std::fprintf(stderr, "  %s done at %.2f s\n", what, now_s() - m_start);
-  }
-
-  void remember_if_best(const Eigen::VectorXd& rest, double avg_error) {
-    if (avg_error >= m_best_error) return;
-    m_best_error = avg_error;
-    m_best_rest = rest;
-    m_best_x = m_x;
-    m_best_pressure = m_pressure;
-  }
-
-  static TriMesh start_shape(const TriMesh& target, const DesignOptions& options) {
-    TriMesh start = target;
-    const double scale = options.scale > 0 ? options.scale : std::cbrt(1.0 / options.volume_ratio);
-    if (options.initial_rest.rows() == 0) {
-      start.vertices = scaled_about_centroid(target.vertices, scale);
-      return start;
-    }
-    const double wanted_volume = scale * scale * scale * enclosed_volume(target.vertices, target.faces);
-    const double given_volume = enclosed_volume(options.initial_rest, target.faces);
-    start.vertices = scaled_about_centroid(options.initial_rest, std::cbrt(wanted_volume / given_volume));
-    return start;
-  }
-
-  static std::vector<bool> rigid_support(const TriMesh& mesh) {
-    std::vector<bool> fixed(static_cast<size_t>(3 * mesh.vertex_count()), false);
-    for (int c : rigid_support_coordinates(mesh.vertices)) fixed[static_cast<size_t>(c)] = true;
-    return fixed;
-  }
-
-  /// Restores the rest volume after a step, moving only free vertices along the volume gradient.
-  Eigen::VectorXd keep_rest_volume(Eigen::VectorXd rest, double volume) const {
-    for (int pass = 0; pass < 2; ++pass) {
-      Eigen::VectorXd w = m_model.volume_gradient(rest);
-      for (int c = 0; c < w.size(); ++c)
-        if (!m_rest_free[static_cast<size_t>(c)]) w[c] = 0.0;
-      rest += ((volume - rest_volume(rest)) / w.squaredNorm()) * w;
-    }
-    return rest;
-  }
-
-  double rest_volume(const Eigen::VectorXd& rest) const {
-    return enclosed_volume(unflatten(rest), m_target.faces);
-  }
-
-  bool stopped() const {
-    return m_last_report.stop == NewtonStop::Cancelled || m_last_report.stop == NewtonStop::TimeLimit;
-  }
-
-  /// Volume-controlled equilibrium of `rest` from (x, p); false when it does not converge.
-  bool equilibrium(const Eigen::VectorXd& rest, Eigen::VectorXd& x, double& pressure) {
-    m_model.set_rest_positions(unflatten(rest));
-    // A trial starts a first-order step from its solution; one that needs many Newton steps has entered
-    // a wrinkling region, and a shorter step is cheaper than following the slow path to the end.
-    NewtonSettings settings = m_settings;
-    settings.max_iterations = TRIAL_NEWTON_ITERATIONS;
-    m_last_report = m_solver.solve_volume(x, pressure, m_target_volume, settings);
-    return m_last_report.converged;
-  }
-
-  /// The start's inflation, by volume steps when one step is too far.
-  bool initial_inflation(const Eigen::VectorXd& rest, DesignResult& result) {
-    m_model.set_rest_positions(unflatten(rest));
-    const double start_volume = rest_volume(rest);
-    const Positions rest_positions = unflatten(rest);
-    double reached = start_volume;
-    Eigen::VectorXd x = rest;
-    double pressure = 0.0;
-    double step = m_target_volume - start_volume;
-    while (reached < m_target_volume) {
-      const double next = std::min(m_target_volume, reached + step);
-      Eigen::VectorXd trial = flat(scaled_about_centroid(unflatten(x), std::cbrt(next / enclosed_volume(unflatten(x), m_target.faces))));
-      double trial_pressure = pressure;
-      if (trial_pressure == 0.0) {
-        const Eigen::VectorXd g = m_solver.residual(trial, 0.0);
-        Eigen::VectorXd v = m_model.volume_gradient(trial);
-        trial_pressure = g.dot(v) / v.squaredNorm();
-      }
-      m_last_report = m_solver.solve_volume(trial, trial_pressure, next, m_settings);
-      if (m_last_report.converged) {
-        x = trial;
-        pressure = trial_pressure;
-        reached = next;
-        continue;
-      }
-      if (stopped()) {
-        stop_with(result, m_last_report.message == "cancelled" ? DesignStop::Cancelled : DesignStop::TimeLimit,
-                  m_last_report.message + " while inflating the start");
-        return false;
-      }
-      if (step < 1e-3 * (m_target_volume - start_volume)) {
-        stop_with(result, DesignStop::StartFailed,
-                  "the start shape could not be inflated to the target volume (" + m_last_report.message + ")");
-        return false;
-      }
-      step *= 0.5;
-    }
-    // Place the inflated start on the target (a rigid motion of an equilibrium is one): the pinned
-    // coordinates then hold it in the target's frame, where E_surf and the errors are measured. A
-    // perturbed or user-given start need not inflate in place.
-    m_x = flat(rigid_align_to(unflatten(x), m_target.vertices));
-    m_pressure = pressure;
-    return true;
-  }
-
-  /// Brings a checkpoint's rest shape (at this design's rest volume) to equilibrium from the inflated
-  /// start, through rest shapes blended from the start's in RESUME_STEPS steps. On success `rest`, m_x
-  /// and m_pressure are the checkpoint's; otherwise nothing changes.
-  bool resume_from(const DesignCheckpoint& checkpoint, Eigen::VectorXd& rest) {
-    if (checkpoint.rest.rows() != m_target.vertex_count() || checkpoint.rest.cols() != 3 ||
-        !checkpoint.rest.allFinite() || checkpoint.iteration < 1 || checkpoint.iteration >= m_options.max_iterations)
-      return false;
-    Eigen::VectorXd goal = flat(checkpoint.rest);
-    for (int c = 0; c < goal.size(); ++c)
-      if (!m_rest_free[static_cast<size_t>(c)]) goal[c] = rest[c];  // the nozzle stays where the start has it
-    goal = keep_rest_volume(goal, rest_volume(rest));
-    Eigen::VectorXd x = m_x;
-    double pressure = m_pressure;
-    for (int step = 1; step <= RESUME_STEPS; ++step) {
-      const double t = static_cast<double>(step) / RESUME_STEPS;
-      m_model.set_rest_positions(unflatten(Eigen::VectorXd((1.0 - t) * rest + t * goal)));
-      m_last_report = m_solver.solve_volume(x, pressure, m_target_volume, m_settings);
-      if (!m_last_report.converged) {
-        m_model.set_rest_positions(unflatten(rest));
-        return false;
-      }
-    }
-    rest = goal;
-    m_x = x;
-    m_pressure = pressure;
-    return true;
-  }
-
   /// d objective / d rest through the adjoint of the bordered equilibrium system at (m_x, m_pressure):
   /// [K -v; -v^T 0] [lambda; mu] = [dE/dx; 0], gradient = -(d grad_x W / d rest)^T lambda.
   bool objective_gradient(const Eigen::VectorXd& rest, Eigen::VectorXd& gradient) {
@@ -735,88 +340,262 @@ class AdjointDesign {
     return q;
   }
 
-  void record(DesignResult& result, int iteration, const SurfaceDistanceStats& stats, const Eigen::VectorXd& rest) {
-    ConvergenceSample sample;
-    sample.time_s = now_s() - m_start;
-    sample.iteration = iteration;
-    sample.avg_error_mm = stats.avg_mm;
-    sample.max_error_mm = stats.max_mm;
-    sample.residual_norm = m_last_report.residual_norm;
-    result.log.push_back(sample);
-    if (!m_options.progress) return;
-    ProgressEvent event;
-    event.phase = iteration == 0 ? "start" : "design";
-    event.iteration = iteration;
-    event.elapsed_s = sample.time_s;
-    event.avg_error_mm = stats.avg_mm;
-    event.max_error_mm = stats.max_mm;
-    event.residual_norm = sample.residual_norm;
-    event.pressure_kpa = m_pressure / MPA_PER_KPA;
-    Positions shape;
-    const int every = std::max(1, m_options.progress_mesh_every);
-    if (iteration % every == 0) {
-      shape = rigid_align_to(unflatten(m_x), m_target.vertices);
-      event.shape = &shape;
-    }
-    const Positions rest_shape = unflatten(rest);
-    event.rest_shape = &rest_shape;
-    m_options.progress(event);
-  }
-
-  /// Sets the stop reason and its sentence.
-  static void stop_with(DesignResult& result, DesignStop stop, std::string message) {
-    result.stop = stop;
-    result.message = std::move(message);
-  }
-
-  /// The result's shapes and errors. Without an inflated start (start_failed, or stopped before it)
-  /// there is no design: the errors stay empty, the rest shape is the start, nothing is called converged.
-  DesignResult& finish(DesignResult& result, const Eigen::VectorXd& rest) {
-    result.rest = m_target;
-    result.rest.vertices = unflatten(rest);
-    result.time_s = now_s() - m_start;
-    const bool inflated = !result.log.empty();
-    result.converged = inflated && m_final_equilibrium &&
-                       (result.stop == DesignStop::Matched || result.stop == DesignStop::Optimal);
-    if (!inflated) {
-      result.inflated = result.rest.vertices;
-      return result;
-    }
-    result.inflated = rigid_align_to(unflatten(m_x), m_target.vertices);
-    result.pressure_kpa = m_pressure / MPA_PER_KPA;
-    result.volume_ratio = enclosed_volume(unflatten(m_x), m_target.faces) / rest_volume(rest);
-    const SurfaceDistanceStats stats = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
-    result.avg_error_mm = stats.avg_mm;
-    result.max_error_mm = stats.max_mm;
-    result.avg_error_rel = stats.avg_rel;
-    result.max_error_rel = stats.max_rel;
-    result.distance_energy = m_distance.value(m_x);
-    m_model.set_rest_positions(result.rest.vertices);
-    result.residual_norm = m_solver.residual(m_x, m_pressure).norm();
-    return result;
-  }
-
+  DesignDriver& m_driver;
   const TriMesh& m_target;
   const DesignOptions& m_options;
-  double m_start;
-  TriMesh m_rest_mesh;
-  fem::BalloonModel m_model;
-  EquilibriumSolver m_solver;
-  AdjointSensitivity m_sensitivity;  ///< dx/drest at the current equilibrium: the gradient and the predictor
-  DesignObjective m_objective;
+  fem::BalloonModel& m_model;
+  EquilibriumSolver& m_solver;
+  AdjointSensitivity& m_sensitivity;
+  DesignObjective& m_objective;
   const DistanceEnergy& m_distance;
   const SurfaceDistance& m_surface;
+  const NewtonSettings& m_settings;
+  const std::vector<bool>& m_rest_free;
+  const double m_target_volume;
+  Eigen::VectorXd& m_x;           ///< the driver's current equilibrium
+  double& m_pressure;
+  NewtonReport& m_last_report;
   std::unique_ptr<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>>> m_preconditioner;
-  double m_target_volume;
-  std::vector<bool> m_rest_free;
-  NewtonSettings m_settings;
-  NewtonReport m_last_report;
-  Eigen::VectorXd m_x;
-  double m_pressure = 0.0;
-  double m_best_error = std::numeric_limits<double>::infinity();
-  Eigen::VectorXd m_best_rest, m_best_x;
-  double m_best_pressure = 0.0;
-  bool m_final_equilibrium = true;  ///< alm: whether the final rest shape's re-inflation converged
+};
+
+class AugmentedLagrangianDesign {
+ public:
+  explicit AugmentedLagrangianDesign(DesignDriver& driver)
+      : m_driver(driver),
+        m_target(driver.target()),
+        m_options(driver.options()),
+        m_model(driver.model()),
+        m_solver(driver.solver()),
+        m_sensitivity(driver.sensitivity()),
+        m_objective(driver.objective()),
+        m_distance(driver.objective().distance()),
+        m_surface(driver.objective().surface()),
+        m_settings(driver.settings()),
+        m_rest_free(driver.rest_free()),
+        m_target_volume(driver.target_volume()),
+        m_x(driver.x()),
+        m_pressure(driver.pressure()),
+        m_last_report(driver.last_report()) {}
+
+  /// The paper's method (sec. 5.2): minimise E_dist(x) + R(rest) - lambda^T C + mu/2 |C|^2 over rest and
+  /// inflated positions together, C = grad_x W(x; rest) - p grad V(x) the nodal force balance at the
+  /// start's pressure p (R: the active regularizers). Multipliers update by eq. 22 when |C| fell to a
+  /// quarter, else mu grows tenfold. The inner solve is Gauss-Newton with Levenberg-Marquardt damping and
+  /// a backtracking line search: the Hessian is approximated by H_dist^GN + mu J^T J with J = [dC/drest,
+  /// dC/dx] = [M, K] (the term lambda^T d2C is dropped), factorized by CHOLMOD on a pattern analysed once.
+  /// At the end the rest shape is inflated properly, so the reported errors are a true equilibrium's.
+  DesignResult run() {
+    DesignResult result = m_driver.begin(DesignMethod::AugmentedLagrangian);
+    Eigen::VectorXd rest = flat(m_driver.start().vertices);
+    if (!m_driver.inflate_start(rest, result)) return m_driver.finish(result, rest);
+
+    const Eigen::Index n = rest.size();
+    std::vector<bool> free(static_cast<size_t>(2 * n));
+    for (Eigen::Index c = 0; c < n; ++c) {
+      free[static_cast<size_t>(c)] = m_rest_free[static_cast<size_t>(c)];
+      free[static_cast<size_t>(n + c)] = m_solver.assembly().free_index(static_cast<int>(c)) >= 0;
+    }
+    const double pressure = m_pressure;
+    const double force_scale = m_solver.force_scale(m_x, pressure);
+    const double start_distance = std::max(m_distance.value(m_x), 1e-6 * result.bbox_diag_mm);
+    double mu = 10.0 * start_distance / (force_scale * force_scale);
+    Eigen::VectorXd lambda = Eigen::VectorXd::Zero(n);
+    Eigen::VectorXd z(2 * n);
+    z << rest, m_x;
+    auto constraints = [&](const Eigen::VectorXd& zz) {
+      m_model.set_rest_positions(unflatten(zz.head(n)));
+      return m_solver.residual(zz.tail(n), pressure);
+    };
+    auto lagrangian = [&](const Eigen::VectorXd& zz, Eigen::VectorXd* gradient) {
+      const Eigen::VectorXd c = constraints(zz);
+      Eigen::VectorXd surface_gradient;
+      const double value = m_distance.value(zz.tail(n)) +
+                           m_objective.surface_term(zz.tail(n), gradient ? &surface_gradient : nullptr) +
+                           m_objective.regularizer_value(zz.head(n)) - lambda.dot(c) + 0.5 * mu * c.squaredNorm();
+      if (gradient) {
+        const Eigen::VectorXd w = mu * c - lambda;
+        Eigen::VectorXd distance_gradient;
+        m_distance.gradient(zz.tail(n), distance_gradient);
+        distance_gradient += surface_gradient;
+        gradient->resize(2 * n);
+        gradient->head(n) = m_sensitivity.mixed_product(zz.head(n), zz.tail(n), w, true);
+        m_objective.add_regularizer_gradient(zz.head(n), gradient->head(n));
+        gradient->tail(n) = distance_gradient + m_solver.stiffness_times(zz.tail(n), pressure, w);
+        for (Eigen::Index c2 = 0; c2 < 2 * n; ++c2)
+          if (!free[static_cast<size_t>(c2)]) (*gradient)[c2] = 0.0;
+      }
+      return value;
+    };
+
+    Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> factorization;
+    bool analysed = false;
+    double damping = 0.0;  // Levenberg-Marquardt, relative to the mean diagonal
+    int iteration = 0;
+    double constraint_norm = constraints(z).norm();
+    stop_with(result, DesignStop::IterationLimit, "iteration limit reached");
+    for (int outer = 0; outer < 30 && iteration < m_options.max_iterations; ++outer) {
+      Eigen::VectorXd gradient;
+      double value = lagrangian(z, &gradient);
+      const double inner_tolerance = 1e-3 * gradient.norm();
+      for (int inner = 0; inner < 20 && iteration < m_options.max_iterations; ++inner) {
+        if (m_options.cancel && m_options.cancel->cancelled()) stop_with(result, DesignStop::Cancelled, "cancelled");
+        if (m_settings.deadline_s > 0 && design_clock_s() > m_settings.deadline_s)
+          stop_with(result, DesignStop::TimeLimit, "time limit reached");
+        if (result.stop != DesignStop::IterationLimit) break;
+        ++iteration;
+        Eigen::SparseMatrix<double> hessian = gauss_newton_hessian(z, pressure, mu, free);
+        const double diagonal = hessian.diagonal().mean();
+        if (damping == 0.0) damping = 1e-6;
+        Eigen::VectorXd direction;
+        for (int attempt = 0; attempt < 8; ++attempt) {
+          Eigen::SparseMatrix<double> damped = hessian;
+          for (Eigen::Index c = 0; c < damped.rows(); ++c) damped.coeffRef(c, c) += damping * diagonal;
+          if (!analysed) {
+            factorization.analyzePattern(damped);
+            analysed = true;
+          }
+          factorization.factorize(damped);
+          if (factorization.info() == Eigen::Success) {
+            direction = -factorization.solve(gradient);
+            if (direction.allFinite() && direction.dot(gradient) < 0.0) break;
+          }
+          direction.resize(0);
+          damping *= 10.0;
+        }
+        if (direction.size() == 0) {
+          stop_with(result, DesignStop::Stalled, "stalled: the Gauss-Newton system could not be factorized");
+          break;
+        }
+        // Trust region: no vertex moves more than 2% of the target's size per step.
+        const double largest = std::max(unflatten(direction.head(n)).rowwise().norm().maxCoeff(),
+                                        unflatten(direction.tail(n)).rowwise().norm().maxCoeff());
+        double t = std::min(1.0, 0.02 * result.bbox_diag_mm / std::max(largest, 1e-300));
+        const double slope = direction.dot(gradient);
+        bool accepted = false;
+        for (int k = 0; k < 20 && !accepted; ++k) {
+          const Eigen::VectorXd trial = z + t * direction;
+          const double trial_value = lagrangian(trial, nullptr);
+          if (std::isfinite(trial_value) && trial_value <= value + 1e-4 * t * slope) {
+            z = trial;
+            value = lagrangian(z, &gradient);
+            accepted = true;
+          } else {
+            t *= 0.5;
+          }
+        }
+        damping = accepted && t == 1.0 ? std::max(1e-9, damping * 0.3) : damping * 10.0;
+        if (accepted) {
+          m_x = z.tail(n);
+          m_pressure = pressure;
+          m_last_report.residual_norm = constraints(z).norm();
+          const SurfaceDistanceStats stats = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
+          m_driver.record(result, iteration, stats, z.head(n));
+        }
+        if (!accepted || gradient.norm() <= inner_tolerance) break;
+      }
+      if (result.stop != DesignStop::IterationLimit) break;
+      m_objective.update_max_volume_term(z.head(n), start_distance, result);
+      const Eigen::VectorXd c = constraints(z);
+      const double new_norm = c.norm();
+      if (new_norm <= 0.25 * constraint_norm || new_norm <= 1e-6 * force_scale) {
+        lambda -= mu * c;  // eq. 22
+        constraint_norm = new_norm;
+      } else {
+        mu *= 10.0;
+      }
+      lagrangian(z, &gradient);
+      if (new_norm <= 1e-6 * force_scale && gradient.norm() < 1e-4 * force_scale) {
+        stop_with(result, DesignStop::Optimal,
+                  "optimal: force residual below 1e-6 and Lagrangian gradient below 1e-4 of the force scale");
+        break;
+      }
+    }
+    result.iterations = iteration;
+    // The ALM iterate only nearly balances the forces: report the true equilibrium of its rest shape.
+    rest = z.head(n);
+    Eigen::VectorXd x = z.tail(n);
+    double inflated_pressure = pressure;
+    NewtonSettings settings = m_settings;
+    settings.deadline_s = 0.0;
+    m_model.set_rest_positions(unflatten(rest));
+    m_last_report = m_solver.solve_volume(x, inflated_pressure, m_target_volume, settings);
+    m_x = x;
+    m_pressure = inflated_pressure;
+    m_driver.set_final_equilibrium(m_last_report.converged);
+    if (!m_last_report.converged)
+      result.message += "; the final rest shape did not reach equilibrium (" + m_last_report.message + ")";
+    return m_driver.finish(result, rest);
+  }
+
+ private:
+  /// Gauss-Newton Hessian of the augmented Lagrangian over z = (rest, x): H_dist^GN(x) on the x block,
+  /// the rest-bending Gauss-Newton block when active, plus mu J^T J with J = [M, K]. Fixed coordinates
+  /// get zero rows and columns (the damping makes them identity).
+  Eigen::SparseMatrix<double> gauss_newton_hessian(const Eigen::VectorXd& z, double pressure, double mu,
+                                                   const std::vector<bool>& free) const {
+    const Eigen::Index n = z.size() / 2;
+    const Faces& faces = m_target.faces;
+    std::vector<Eigen::Triplet<double>> jacobian_entries;
+    jacobian_entries.reserve(static_cast<size_t>(faces.rows()) * 162);
+    const Eigen::VectorXd rest = z.head(n), x = z.tail(n);
+    for (int f = 0; f < faces.rows(); ++f) {
+      const fem::Vector9d rest_corners = m_model.corners(rest, f), x_corners = m_model.corners(x, f);
+      const fem::Matrix9d mixed =
+          fem::membrane_mixed_derivative(m_model.material(), m_model.thickness(f), rest_corners, x_corners);
+      double energy = 0.0;
+      fem::Vector9d element_gradient;
+      fem::Matrix9d stiffness;
+      fem::membrane_energy_gradient_hessian(m_model.material(), m_model.thickness(f),
+                                            fem::make_rest_triangle(rest_corners), x_corners, energy,
+                                            element_gradient, stiffness);
+      stiffness -= pressure * fem::triangle_volume_hessian(x_corners);
+      for (int i = 0; i < 9; ++i) {
+        const Eigen::Index row = 3 * faces(f, i / 3) + i % 3;
+        if (!free[static_cast<size_t>(n + row)]) continue;
+        for (int j = 0; j < 9; ++j) {
+          const Eigen::Index column = 3 * faces(f, j / 3) + j % 3;
+          if (free[static_cast<size_t>(column)]) jacobian_entries.emplace_back(row, column, mixed(i, j));
+          if (free[static_cast<size_t>(n + column)]) jacobian_entries.emplace_back(row, n + column, stiffness(i, j));
+        }
+      }
+    }
+    Eigen::SparseMatrix<double> jacobian(n, 2 * n);
+    jacobian.setFromTriplets(jacobian_entries.begin(), jacobian_entries.end());
+    Eigen::SparseMatrix<double> hessian = mu * Eigen::SparseMatrix<double>(jacobian.transpose() * jacobian);
+    std::vector<Eigen::Triplet<double>> objective_entries;
+    m_distance.hessian_triplets(z.tail(n), objective_entries, DistanceHessian::GaussNewton, static_cast<int>(n));
+    if (m_objective.rest_bending_active())
+      m_objective.start_hinges().hessian_triplets(z.head(n), objective_entries, DistanceHessian::GaussNewton, 0);
+    m_objective.add_surface_hessian(z.tail(n), objective_entries, static_cast<int>(n));
+    std::vector<Eigen::Triplet<double>> kept;
+    kept.reserve(objective_entries.size());
+    for (const auto& entry : objective_entries)
+      if (free[static_cast<size_t>(entry.row())] && free[static_cast<size_t>(entry.col())]) kept.push_back(entry);
+    Eigen::SparseMatrix<double> objective(2 * n, 2 * n);
+    objective.setFromTriplets(kept.begin(), kept.end());
+    hessian += objective;
+    // Every diagonal entry exists, so the damping adds to the pattern the analysis saw.
+    Eigen::SparseMatrix<double> identity(2 * n, 2 * n);
+    identity.setIdentity();
+    hessian += 0.0 * identity;
+    return hessian;
+  }
+
+  DesignDriver& m_driver;
+  const TriMesh& m_target;
+  const DesignOptions& m_options;
+  fem::BalloonModel& m_model;
+  EquilibriumSolver& m_solver;
+  AdjointSensitivity& m_sensitivity;
+  DesignObjective& m_objective;
+  const DistanceEnergy& m_distance;
+  const SurfaceDistance& m_surface;
+  const NewtonSettings& m_settings;
+  const std::vector<bool>& m_rest_free;
+  const double m_target_volume;
+  Eigen::VectorXd& m_x;           ///< the driver's current equilibrium
+  double& m_pressure;
+  NewtonReport& m_last_report;
 };
 
 std::string options_problem(const TriMesh& target, const DesignOptions& options) {
@@ -855,8 +634,9 @@ DesignResult design_balloon(const TriMesh& target, const DesignOptions& options)
     result.inflated = target.vertices;
     return result;
   }
-  AdjointDesign design(target, options);
-  return design.run();
+  DesignDriver driver(target, options);
+  if (options.method == DesignMethod::AugmentedLagrangian) return AugmentedLagrangianDesign(driver).run();
+  return ReducedSpaceDesign(driver).run();
 }
 
 }  // namespace balloon
