@@ -1,18 +1,17 @@
 #include "design/reduced_space_design.hpp"
 
-#include <Eigen/CholmodSupport>
 #include <Eigen/SparseCore>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <deque>
-#include <memory>
+#include <utility>
 #include <string>
 #include <vector>
 
 #include "design/adjoint_sensitivity.hpp"
 #include "design/design_objective.hpp"
 #include "design/distance_energy.hpp"
+#include "design/lbfgs.hpp"
 #include "design/surface_distance.hpp"
 #include "solve/equilibrium_solver.hpp"
 
@@ -98,7 +97,6 @@ class ReducedSpaceDesign {
     const double initial_objective = objective;
     build_preconditioner();
     m_driver.debug_time("first gradient and preconditioner");
-    std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> memory;  // (s, y) pairs for L-BFGS
     int small_decreases = 0;
     double stall_objective = objective;         // objective at the last real improvement of either
     int stall_iteration = first_iteration - 1;
@@ -114,11 +112,11 @@ class ReducedSpaceDesign {
         stop_with(result, DesignStop::TimeLimit, "time limit reached");
         break;
       }
-      Eigen::VectorXd direction = -lbfgs_apply(memory, gradient);
+      Eigen::VectorXd direction = -m_lbfgs.apply(gradient);
       for (int c = 0; c < direction.size(); ++c)
         if (!m_rest_free[static_cast<size_t>(c)]) direction[c] = 0.0;
       if (!(direction.dot(gradient) < 0.0)) {
-        memory.clear();
+        m_lbfgs.clear();
         direction = -gradient;
       }
       // Trust region on the rest shape: no vertex moves more than `radius` (at most 2% of the target's
@@ -127,7 +125,7 @@ class ReducedSpaceDesign {
       const double largest = unflatten(direction).rowwise().norm().maxCoeff();
       double t = largest > radius ? radius / largest : 1.0;
       const double first_t = t;
-      if (memory.empty()) t = std::min(t, 0.002 * result.bbox_diag_mm / std::max(largest, 1e-300));
+      if (m_lbfgs.empty()) t = std::min(t, 0.002 * result.bbox_diag_mm / std::max(largest, 1e-300));
       const double slope = direction.dot(gradient);
       // First-order response of the equilibrium to the rest step, from the factorization the gradient
       // just used: each trial starts Newton a second-order distance from its solution.
@@ -161,8 +159,8 @@ class ReducedSpaceDesign {
                     m_last_report.message);
           break;
         }
-        if (!memory.empty()) {  // a stale curvature model: restart from steepest descent
-          memory.clear();
+        if (!m_lbfgs.empty()) {  // a stale curvature model: restart from steepest descent
+          m_lbfgs.clear();
           continue;
         }
         // A failed line search is optimality only where the gradient has vanished; elsewhere it is a stall
@@ -192,10 +190,7 @@ class ReducedSpaceDesign {
       }
       m_driver.debug_time("gradient");
       const Eigen::VectorXd change = new_gradient - gradient;
-      if (step.dot(change) > 1e-12 * step.norm() * change.norm()) {
-        memory.emplace_back(step, change);
-        if (memory.size() > 30) memory.pop_front();
-      }
+      m_lbfgs.update(step, change);
       gradient = new_gradient;
       const SurfaceDistanceStats stats = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
       m_driver.record(result, iteration, stats, rest);
@@ -228,7 +223,7 @@ class ReducedSpaceDesign {
       } else if (iteration - stall_iteration >= STALL_ITERATIONS && m_objective.realign(m_x)) {
         // The pinned coordinates held the shape where the start put it; re-placed on the target, the
         // surface term can pull again. A rigid motion of an equilibrium is one: only the gauge changed.
-        memory.clear();
+        m_lbfgs.clear();
         stall_iteration = iteration;
         objective = m_objective.value(rest, m_x);
         stall_objective = objective;
@@ -276,38 +271,7 @@ class ReducedSpaceDesign {
     m_objective.add_surface_hessian(m_x, entries, 0);
     Eigen::SparseMatrix<double> hessian(m_x.size(), m_x.size());
     hessian.setFromTriplets(entries.begin(), entries.end());
-    const double shift = 1e-3 * hessian.diagonal().mean();
-    for (int c = 0; c < hessian.rows(); ++c) hessian.coeffRef(c, c) += shift;
-    m_preconditioner = std::make_unique<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>>>(hessian);
-    if (m_preconditioner->info() != Eigen::Success) m_preconditioner.reset();
-  }
-
-  Eigen::VectorXd precondition(const Eigen::VectorXd& q) const {
-    if (!m_preconditioner) return q;
-    Eigen::VectorXd r = m_preconditioner->solve(q);
-    return r.allFinite() ? r : q;
-  }
-
-  Eigen::VectorXd lbfgs_apply(const std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>>& memory,
-                              const Eigen::VectorXd& gradient) const {
-    Eigen::VectorXd q = gradient;
-    std::vector<double> alpha(memory.size());
-    for (int i = static_cast<int>(memory.size()) - 1; i >= 0; --i) {
-      const auto& [s, y] = memory[static_cast<size_t>(i)];
-      alpha[static_cast<size_t>(i)] = s.dot(q) / y.dot(s);
-      q -= alpha[static_cast<size_t>(i)] * y;
-    }
-    q = precondition(q);
-    if (!memory.empty()) {
-      const auto& [s, y] = memory.back();
-      q *= s.dot(y) / y.dot(precondition(y));
-    }
-    for (size_t i = 0; i < memory.size(); ++i) {
-      const auto& [s, y] = memory[i];
-      const double beta = y.dot(q) / y.dot(s);
-      q += (alpha[i] - beta) * s;
-    }
-    return q;
+    m_lbfgs.set_preconditioner(std::move(hessian));
   }
 
   DesignDriver& m_driver;
@@ -325,7 +289,7 @@ class ReducedSpaceDesign {
   Eigen::VectorXd& m_x;           ///< the driver's current equilibrium
   double& m_pressure;
   NewtonReport& m_last_report;
-  std::unique_ptr<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>>> m_preconditioner;
+  Lbfgs m_lbfgs{30};  ///< L-BFGS on the rest shape: (s, y) pairs of the last 30 accepted steps
 };
 
 }  // namespace
