@@ -1,18 +1,20 @@
 #include "design/augmented_lagrangian_design.hpp"
 
-#include <Eigen/CholmodSupport>
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <vector>
 
 #include "design/adjoint_sensitivity.hpp"
 #include "design/design_objective.hpp"
 #include "design/distance_energy.hpp"
 #include "design/surface_distance.hpp"
+#include "fem/assembly.hpp"
 #include "fem/membrane_element.hpp"
 #include "fem/pressure_load.hpp"
 #include "solve/equilibrium_solver.hpp"
+#include "solve/sparse_solver.hpp"
 
 namespace balloon {
 
@@ -42,7 +44,8 @@ class AugmentedLagrangianDesign {
   /// start's pressure p (R: the active regularizers). Multipliers update by eq. 22 when |C| fell to a
   /// quarter, else mu grows tenfold. The inner solve is Gauss-Newton with Levenberg-Marquardt damping and
   /// a backtracking line search: the Hessian is approximated by H_dist^GN + mu J^T J with J = [dC/drest,
-  /// dC/dx] = [M, K] (the term lambda^T d2C is dropped), factorized by CHOLMOD on a pattern analysed once.
+  /// dC/dx] = [M, K] (the term lambda^T d2C is dropped), assembled through TriangleAssembly and factorized
+  /// by SparseSolver (CHOLMOD) on a pattern analysed once, like the forward solver's Newton systems.
   /// At the end the rest shape is inflated properly, so the reported errors are a true equilibrium's.
   DesignResult run() {
     DesignResult result = m_driver.begin(DesignMethod::AugmentedLagrangian);
@@ -87,8 +90,7 @@ class AugmentedLagrangianDesign {
       return value;
     };
 
-    Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> factorization;
-    bool analysed = false;
+    prepare_hessian(free);
     double damping = 0.0;  // Levenberg-Marquardt, relative to the mean diagonal
     int iteration = 0;
     double constraint_norm = constraints(z).norm();
@@ -103,20 +105,17 @@ class AugmentedLagrangianDesign {
           stop_with(result, DesignStop::TimeLimit, "time limit reached");
         if (result.stop != DesignStop::IterationLimit) break;
         ++iteration;
-        Eigen::SparseMatrix<double> hessian = gauss_newton_hessian(z, pressure, mu, free);
-        const double diagonal = hessian.diagonal().mean();
+        assemble_hessian(z, pressure, mu);
+        // Mean diagonal over all 2n coordinates, the fixed ones counting as 0 (damping scale).
+        const double diagonal = m_hessian->mean_abs_diagonal() * m_hessian->free_count() / static_cast<double>(2 * n);
         if (damping == 0.0) damping = 1e-6;
+        const bool finite = gradient.allFinite() &&
+                            std::all_of(m_hessian->values().begin(), m_hessian->values().end(),
+                                        [](double v) { return std::isfinite(v); });
         Eigen::VectorXd direction;
         for (int attempt = 0; attempt < 8; ++attempt) {
-          Eigen::SparseMatrix<double> damped = hessian;
-          for (Eigen::Index c = 0; c < damped.rows(); ++c) damped.coeffRef(c, c) += damping * diagonal;
-          if (!analysed) {
-            factorization.analyzePattern(damped);
-            analysed = true;
-          }
-          factorization.factorize(damped);
-          if (factorization.info() == Eigen::Success) {
-            direction = -factorization.solve(gradient);
+          if (finite && m_linear.factorize_llt(m_hessian->values(), damping * diagonal) == SparseSolver::Status::Ok) {
+            direction = -m_hessian->extend(m_linear.solve(m_hessian->restrict(gradient)));
             if (direction.allFinite() && direction.dot(gradient) < 0.0) break;
           }
           direction.resize(0);
@@ -188,57 +187,89 @@ class AugmentedLagrangianDesign {
   }
 
  private:
-  /// Gauss-Newton Hessian of the augmented Lagrangian over z = (rest, x): H_dist^GN(x) on the x block,
-  /// the rest-bending Gauss-Newton block when active, plus mu J^T J with J = [M, K]. Fixed coordinates
-  /// get zero rows and columns (the damping makes them identity).
-  Eigen::SparseMatrix<double> gauss_newton_hessian(const Eigen::VectorXd& z, double pressure, double mu,
-                                                   const std::vector<bool>& free) const {
+  /// The Hessian's pattern over z = (rest, x), as 2#V vertices (rest v is vertex v, inflated v is
+  /// vertex #V + v): each vertex's row of J = [M, K] couples its one-ring's rest and inflated coordinates,
+  /// so J^T J couples every two of them; the objective's edges and hinges lie within a one-ring too.
+  /// Fixed coordinates (`free` false) have no row or column.
+  void prepare_hessian(const std::vector<bool>& free) {
+    const Faces& faces = m_target.faces;
+    const int vertices = m_target.vertex_count();
+    m_vertex_faces.assign(static_cast<size_t>(vertices), {});
+    m_rings.assign(static_cast<size_t>(vertices), {});
+    for (int f = 0; f < faces.rows(); ++f) {
+      for (int k = 0; k < 3; ++k) {
+        m_vertex_faces[static_cast<size_t>(faces(f, k))].push_back(f);
+        for (int j = 0; j < 3; ++j) m_rings[static_cast<size_t>(faces(f, k))].push_back(faces(f, j));
+      }
+    }
+    std::vector<std::vector<int>> groups(static_cast<size_t>(vertices));
+    for (int v = 0; v < vertices; ++v) {
+      auto& ring = m_rings[static_cast<size_t>(v)];
+      ring.push_back(v);
+      std::sort(ring.begin(), ring.end());
+      ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+      auto& group = groups[static_cast<size_t>(v)];
+      for (int u : ring) group.push_back(u);
+      for (int u : ring) group.push_back(vertices + u);
+    }
+    std::vector<bool> fixed(free.size());
+    for (size_t c = 0; c < free.size(); ++c) fixed[c] = !free[c];
+    m_hessian = std::make_unique<fem::TriangleAssembly>(groups, 2 * vertices, fixed);
+    m_linear.set_pattern(m_hessian->free_count(), m_hessian->column_starts(), m_hessian->row_indices());
+  }
+
+  /// Gauss-Newton Hessian of the augmented Lagrangian over z = (rest, x) into m_hessian: mu J^T J with
+  /// J = [M, K], one dense one-ring block per vertex's rows of J, plus H_dist^GN(x) on the x block, the
+  /// rest-bending Gauss-Newton block when active, and E_surf's.
+  void assemble_hessian(const Eigen::VectorXd& z, double pressure, double mu) {
     const Eigen::Index n = z.size() / 2;
     const Faces& faces = m_target.faces;
-    std::vector<Eigen::Triplet<double>> jacobian_entries;
-    jacobian_entries.reserve(static_cast<size_t>(faces.rows()) * 162);
+    const int vertices = m_target.vertex_count();
     const Eigen::VectorXd rest = z.head(n), x = z.tail(n);
+    std::vector<fem::Matrix9d> mixed(static_cast<size_t>(faces.rows())), stiffness(static_cast<size_t>(faces.rows()));
     for (int f = 0; f < faces.rows(); ++f) {
       const fem::Vector9d rest_corners = m_model.corners(rest, f), x_corners = m_model.corners(x, f);
-      const fem::Matrix9d mixed =
+      mixed[static_cast<size_t>(f)] =
           fem::membrane_mixed_derivative(m_model.material(), m_model.thickness(f), rest_corners, x_corners);
       double energy = 0.0;
       fem::Vector9d element_gradient;
-      fem::Matrix9d stiffness;
       fem::membrane_energy_gradient_hessian(m_model.material(), m_model.thickness(f),
                                             fem::make_rest_triangle(rest_corners), x_corners, energy,
-                                            element_gradient, stiffness);
-      stiffness -= pressure * fem::triangle_volume_hessian(x_corners);
-      for (int i = 0; i < 9; ++i) {
-        const Eigen::Index row = 3 * faces(f, i / 3) + i % 3;
-        if (!free[static_cast<size_t>(n + row)]) continue;
-        for (int j = 0; j < 9; ++j) {
-          const Eigen::Index column = 3 * faces(f, j / 3) + j % 3;
-          if (free[static_cast<size_t>(column)]) jacobian_entries.emplace_back(row, column, mixed(i, j));
-          if (free[static_cast<size_t>(n + column)]) jacobian_entries.emplace_back(row, n + column, stiffness(i, j));
+                                            element_gradient, stiffness[static_cast<size_t>(f)]);
+      stiffness[static_cast<size_t>(f)] -= pressure * fem::triangle_volume_hessian(x_corners);
+    }
+    m_hessian->set_zero();
+    Eigen::MatrixXd jacobian, block;
+    std::vector<int> coordinates;
+    for (int v = 0; v < vertices; ++v) {
+      const std::vector<int>& ring = m_rings[static_cast<size_t>(v)];
+      const int m = static_cast<int>(ring.size());
+      jacobian.setZero(3, 6 * m);
+      for (int f : m_vertex_faces[static_cast<size_t>(v)]) {
+        const int k = faces(f, 0) == v ? 0 : faces(f, 1) == v ? 1 : 2;
+        for (int j = 0; j < 3; ++j) {
+          const int local = static_cast<int>(std::lower_bound(ring.begin(), ring.end(), faces(f, j)) - ring.begin());
+          jacobian.block<3, 3>(0, 3 * local) += mixed[static_cast<size_t>(f)].block<3, 3>(3 * k, 3 * j);
+          jacobian.block<3, 3>(0, 3 * (m + local)) += stiffness[static_cast<size_t>(f)].block<3, 3>(3 * k, 3 * j);
         }
       }
+      // Rows of fixed inflated coordinates are no constraints (their residual is zero).
+      for (int a = 0; a < 3; ++a)
+        if (m_hessian->free_index(static_cast<int>(n) + 3 * v + a) < 0) jacobian.row(a).setZero();
+      block.noalias() = mu * jacobian.transpose() * jacobian;
+      coordinates.clear();
+      for (int u : ring)
+        for (int a = 0; a < 3; ++a) coordinates.push_back(3 * u + a);
+      for (int u : ring)
+        for (int a = 0; a < 3; ++a) coordinates.push_back(static_cast<int>(n) + 3 * u + a);
+      m_hessian->add_block(coordinates, block);
     }
-    Eigen::SparseMatrix<double> jacobian(n, 2 * n);
-    jacobian.setFromTriplets(jacobian_entries.begin(), jacobian_entries.end());
-    Eigen::SparseMatrix<double> hessian = mu * Eigen::SparseMatrix<double>(jacobian.transpose() * jacobian);
     std::vector<Eigen::Triplet<double>> objective_entries;
-    m_distance.hessian_triplets(z.tail(n), objective_entries, DistanceHessian::GaussNewton, static_cast<int>(n));
+    m_distance.hessian_triplets(x, objective_entries, DistanceHessian::GaussNewton, static_cast<int>(n));
     if (m_objective.rest_bending_active())
-      m_objective.start_hinges().hessian_triplets(z.head(n), objective_entries, DistanceHessian::GaussNewton, 0);
-    m_objective.add_surface_hessian(z.tail(n), objective_entries, static_cast<int>(n));
-    std::vector<Eigen::Triplet<double>> kept;
-    kept.reserve(objective_entries.size());
-    for (const auto& entry : objective_entries)
-      if (free[static_cast<size_t>(entry.row())] && free[static_cast<size_t>(entry.col())]) kept.push_back(entry);
-    Eigen::SparseMatrix<double> objective(2 * n, 2 * n);
-    objective.setFromTriplets(kept.begin(), kept.end());
-    hessian += objective;
-    // Every diagonal entry exists, so the damping adds to the pattern the analysis saw.
-    Eigen::SparseMatrix<double> identity(2 * n, 2 * n);
-    identity.setIdentity();
-    hessian += 0.0 * identity;
-    return hessian;
+      m_objective.start_hinges().hessian_triplets(rest, objective_entries, DistanceHessian::GaussNewton, 0);
+    m_objective.add_surface_hessian(x, objective_entries, static_cast<int>(n));
+    for (const auto& entry : objective_entries) m_hessian->add_entry(entry.row(), entry.col(), entry.value());
   }
 
   DesignDriver& m_driver;
@@ -256,6 +287,10 @@ class AugmentedLagrangianDesign {
   Eigen::VectorXd& m_x;           ///< the driver's current equilibrium
   double& m_pressure;
   NewtonReport& m_last_report;
+  std::vector<std::vector<int>> m_vertex_faces;  ///< triangles around each vertex
+  std::vector<std::vector<int>> m_rings;         ///< each vertex and its neighbours, sorted
+  std::unique_ptr<fem::TriangleAssembly> m_hessian;  ///< Gauss-Newton Hessian over the free z coordinates
+  SparseSolver m_linear;                         ///< its LL^T, pattern analysed once
 };
 
 }  // namespace
