@@ -7,16 +7,9 @@
 namespace balloon::fem {
 
 TriangleAssembly::TriangleAssembly(const Faces& faces, int vertex_count, const std::vector<bool>& fixed_coordinate) {
-  const int coordinates = 3 * vertex_count;
-  if (static_cast<int>(fixed_coordinate.size()) != coordinates)
+  if (static_cast<int>(fixed_coordinate.size()) != 3 * vertex_count)
     throw std::invalid_argument("TriangleAssembly: fixed_coordinate must have 3#V entries");
-  m_free_index.assign(static_cast<size_t>(coordinates), -1);
-  for (int c = 0; c < coordinates; ++c) {
-    if (!fixed_coordinate[static_cast<size_t>(c)]) {
-      m_free_index[static_cast<size_t>(c)] = m_free_count++;
-      m_free_to_coordinate.push_back(c);
-    }
-  }
+  number_free_coordinates(fixed_coordinate);
 
   // Rows of each column: the free coordinates of all vertices sharing a triangle, upper part only.
   std::vector<std::vector<int>> rows_of_column(static_cast<size_t>(m_free_count));
@@ -31,25 +24,8 @@ TriangleAssembly::TriangleAssembly(const Faces& faces, int vertex_count, const s
       }
     }
   }
-  m_column_starts.assign(static_cast<size_t>(m_free_count) + 1, 0);
-  for (int c = 0; c < m_free_count; ++c) {
-    auto& rows = rows_of_column[static_cast<size_t>(c)];
-    rows.push_back(c);  // always keep the diagonal, even for an isolated coordinate
-    std::sort(rows.begin(), rows.end());
-    rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
-    m_column_starts[static_cast<size_t>(c) + 1] = m_column_starts[static_cast<size_t>(c)] + static_cast<int>(rows.size());
-  }
-  m_row_indices.reserve(static_cast<size_t>(m_column_starts.back()));
-  for (const auto& rows : rows_of_column) m_row_indices.insert(m_row_indices.end(), rows.begin(), rows.end());
-  m_values.assign(m_row_indices.size(), 0.0);
+  set_pattern(rows_of_column);
 
-  auto slot = [&](int row, int col) {
-    const auto begin = m_row_indices.begin() + m_column_starts[static_cast<size_t>(col)];
-    const auto end = m_row_indices.begin() + m_column_starts[static_cast<size_t>(col) + 1];
-    return static_cast<int>(std::lower_bound(begin, end, row) - m_row_indices.begin());
-  };
-  m_diagonal_slots.resize(static_cast<size_t>(m_free_count));
-  for (int c = 0; c < m_free_count; ++c) m_diagonal_slots[static_cast<size_t>(c)] = slot(c, c);
   m_element_slots.assign(static_cast<size_t>(faces.rows()) * 81, -1);
   for (int f = 0; f < faces.rows(); ++f) {
     for (int k = 0; k < 9; ++k) {
@@ -63,6 +39,62 @@ TriangleAssembly::TriangleAssembly(const Faces& faces, int vertex_count, const s
   }
 }
 
+TriangleAssembly::TriangleAssembly(const std::vector<std::vector<int>>& vertex_groups, int vertex_count,
+                                   const std::vector<bool>& fixed_coordinate) {
+  if (static_cast<int>(fixed_coordinate.size()) != 3 * vertex_count)
+    throw std::invalid_argument("TriangleAssembly: fixed_coordinate must have 3#V entries");
+  number_free_coordinates(fixed_coordinate);
+  std::vector<std::vector<int>> rows_of_column(static_cast<size_t>(m_free_count));
+  std::vector<int> free_coordinates;
+  for (const auto& group : vertex_groups) {
+    free_coordinates.clear();
+    for (int v : group) {
+      if (v < 0 || v >= vertex_count) throw std::invalid_argument("TriangleAssembly: a group vertex does not exist");
+      for (int a = 0; a < 3; ++a)
+        if (const int i = m_free_index[static_cast<size_t>(3 * v + a)]; i >= 0) free_coordinates.push_back(i);
+    }
+    for (int col : free_coordinates)
+      for (int row : free_coordinates)
+        if (row <= col) rows_of_column[static_cast<size_t>(col)].push_back(row);
+  }
+  set_pattern(rows_of_column);
+}
+
+void TriangleAssembly::number_free_coordinates(const std::vector<bool>& fixed_coordinate) {
+  const int coordinates = static_cast<int>(fixed_coordinate.size());
+  m_free_index.assign(static_cast<size_t>(coordinates), -1);
+  for (int c = 0; c < coordinates; ++c) {
+    if (!fixed_coordinate[static_cast<size_t>(c)]) {
+      m_free_index[static_cast<size_t>(c)] = m_free_count++;
+      m_free_to_coordinate.push_back(c);
+    }
+  }
+}
+
+void TriangleAssembly::set_pattern(std::vector<std::vector<int>>& rows_of_column) {
+  m_column_starts.assign(static_cast<size_t>(m_free_count) + 1, 0);
+  for (int c = 0; c < m_free_count; ++c) {
+    auto& rows = rows_of_column[static_cast<size_t>(c)];
+    rows.push_back(c);  // always keep the diagonal, even for an isolated coordinate
+    std::sort(rows.begin(), rows.end());
+    rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+    m_column_starts[static_cast<size_t>(c) + 1] = m_column_starts[static_cast<size_t>(c)] + static_cast<int>(rows.size());
+  }
+  m_row_indices.reserve(static_cast<size_t>(m_column_starts.back()));
+  for (const auto& rows : rows_of_column) m_row_indices.insert(m_row_indices.end(), rows.begin(), rows.end());
+  m_values.assign(m_row_indices.size(), 0.0);
+  m_diagonal_slots.resize(static_cast<size_t>(m_free_count));
+  for (int c = 0; c < m_free_count; ++c) m_diagonal_slots[static_cast<size_t>(c)] = slot(c, c);
+}
+
+int TriangleAssembly::slot(int row, int column) const {
+  const auto begin = m_row_indices.begin() + m_column_starts[static_cast<size_t>(column)];
+  const auto end = m_row_indices.begin() + m_column_starts[static_cast<size_t>(column) + 1];
+  const auto found = std::lower_bound(begin, end, row);
+  if (found == end || *found != row) return -1;
+  return static_cast<int>(found - m_row_indices.begin());
+}
+
 void TriangleAssembly::set_zero() { std::fill(m_values.begin(), m_values.end(), 0.0); }
 
 void TriangleAssembly::add(int face, const Matrix9d& block) {
@@ -70,6 +102,32 @@ void TriangleAssembly::add(int face, const Matrix9d& block) {
   const double* entries = block.data();  // column-major: entry (l, k) at l + 9 k
   for (int i = 0; i < 81; ++i)
     if (slots[i] >= 0) m_values[static_cast<size_t>(slots[i])] += entries[i];
+}
+
+void TriangleAssembly::add_block(const std::vector<int>& coordinates, const Eigen::MatrixXd& block) {
+  const int size = static_cast<int>(coordinates.size());
+  if (block.rows() != size || block.cols() != size)
+    throw std::invalid_argument("TriangleAssembly::add_block: the block does not match its coordinates");
+  for (int k = 0; k < size; ++k) {
+    const int col = m_free_index[static_cast<size_t>(coordinates[static_cast<size_t>(k)])];
+    if (col < 0) continue;
+    for (int l = 0; l < size; ++l) {
+      const int row = m_free_index[static_cast<size_t>(coordinates[static_cast<size_t>(l)])];
+      if (row < 0 || row > col) continue;
+      const int s = slot(row, col);
+      if (s < 0) throw std::out_of_range("TriangleAssembly::add_block: an entry outside the pattern");
+      m_values[static_cast<size_t>(s)] += block(l, k);
+    }
+  }
+}
+
+void TriangleAssembly::add_entry(int row_coordinate, int column_coordinate, double value) {
+  const int row = m_free_index[static_cast<size_t>(row_coordinate)];
+  const int col = m_free_index[static_cast<size_t>(column_coordinate)];
+  if (row < 0 || col < 0 || row > col) return;
+  const int s = slot(row, col);
+  if (s < 0) throw std::out_of_range("TriangleAssembly::add_entry: an entry outside the pattern");
+  m_values[static_cast<size_t>(s)] += value;
 }
 
 void TriangleAssembly::add_to_diagonal(double value) {

@@ -16,6 +16,11 @@ class TriangleAssembly {
  public:
   /// `fixed_coordinate` has 3#V entries (x0, y0, z0, x1, ...); fixed coordinates get no row or column.
   TriangleAssembly(const Faces& faces, int vertex_count, const std::vector<bool>& fixed_coordinate);
+  /// A pattern wider than one triangle: every two vertices of one group couple (e.g. each vertex with
+  /// its one-ring, for a Gauss-Newton J^T J whose rows are per vertex). Filled with add_block and
+  /// add_entry; add() needs the triangle constructor.
+  TriangleAssembly(const std::vector<std::vector<int>>& vertex_groups, int vertex_count,
+                   const std::vector<bool>& fixed_coordinate);
 
   int free_count() const { return m_free_count; }
   /// Free index of a coordinate, or -1 when it is fixed.
@@ -28,6 +33,14 @@ class TriangleAssembly {
   void set_zero();
   /// Adds a symmetric 9x9 block of triangle `face` (its corners in face order).
   void add(int face, const Matrix9d& block);
+  /// Adds a symmetric block over `coordinates` (block(i, j) at coordinates i, j): its upper triangle in
+  /// the free numbering, fixed coordinates skipped. Every pair must be in the pattern (else
+  /// std::out_of_range). Looks each entry up: for blocks other than the triangles' own.
+  void add_block(const std::vector<int>& coordinates, const Eigen::MatrixXd& block);
+  /// Adds `value` at (row, column) when both coordinates are free and the row's free index is not
+  /// above the column's: a symmetric matrix given entry by entry lists its lower triangle as a mirror of
+  /// the upper, which is the part stored. std::out_of_range when the pair is not in the pattern.
+  void add_entry(int row_coordinate, int column_coordinate, double value);
   /// Adds `value` to the diagonal of every free coordinate.
   void add_to_diagonal(double value);
   /// Mean absolute diagonal entry (scale for shifts).
@@ -41,6 +54,13 @@ class TriangleAssembly {
   Eigen::VectorXd multiply(const Eigen::VectorXd& x) const;
 
  private:
+  /// Numbers the free coordinates (m_free_index, m_free_to_coordinate).
+  void number_free_coordinates(const std::vector<bool>& fixed_coordinate);
+  /// Compressed columns from each free column's rows (upper part), with every diagonal kept.
+  void set_pattern(std::vector<std::vector<int>>& rows_of_column);
+  /// Slot of (row, column) in free numbering, row <= column; -1 when not in the pattern.
+  int slot(int row, int column) const;
+
   int m_free_count = 0;
   std::vector<int> m_free_index;
   std::vector<int> m_free_to_coordinate;

@@ -1,0 +1,278 @@
+#include "design/design_driver.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "mesh/mesh_geometry.hpp"
+#include "solve/rigid_modes.hpp"
+
+namespace balloon {
+
+namespace {
+
+/// Rest shapes between the start and a checkpoint solved on the way to the checkpoint's equilibrium.
+constexpr int RESUME_STEPS = 4;
+/// Newton steps a line-search trial may take before the step is halved instead.
+constexpr int TRIAL_NEWTON_ITERATIONS = 10;
+
+Positions scaled_about_centroid(const Positions& points, double scale) {
+  const Eigen::RowVector3d center = points.colwise().mean();
+  Positions scaled = (points.rowwise() - center) * scale;
+  scaled.rowwise() += center;
+  return scaled;
+}
+
+TriMesh start_shape(const TriMesh& target, const DesignOptions& options) {
+  TriMesh start = target;
+  const double scale = options.scale > 0 ? options.scale : std::cbrt(1.0 / options.volume_ratio);
+  if (options.initial_rest.rows() == 0) {
+    start.vertices = scaled_about_centroid(target.vertices, scale);
+    return start;
+  }
+  const double wanted_volume = scale * scale * scale * enclosed_volume(target.vertices, target.faces);
+  const double given_volume = enclosed_volume(options.initial_rest, target.faces);
+  start.vertices = scaled_about_centroid(options.initial_rest, std::cbrt(wanted_volume / given_volume));
+  return start;
+}
+
+std::vector<bool> rigid_support(const TriMesh& mesh) {
+  std::vector<bool> fixed(static_cast<size_t>(3 * mesh.vertex_count()), false);
+  for (int c : rigid_support_coordinates(mesh.vertices)) fixed[static_cast<size_t>(c)] = true;
+  return fixed;
+}
+
+}  // namespace
+
+double design_clock_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+void stop_with(DesignResult& result, DesignStop stop, std::string message) {
+  result.stop = stop;
+  result.message = std::move(message);
+}
+
+DesignDriver::DesignDriver(const TriMesh& target, const DesignOptions& options)
+    : m_target(target),
+      m_options(options),
+      m_start(design_clock_s()),
+      m_rest_mesh(start_shape(target, options)),
+      // Per-element thickness lives in the model from here on; nothing reads options.thickness_mm again.
+      m_model(m_rest_mesh, options.material,
+              std::vector<double>(static_cast<size_t>(target.face_count()), options.thickness_mm)),
+      m_solver(m_model, rigid_support(m_rest_mesh)),
+      m_sensitivity(m_model, m_solver),
+      m_objective(target, m_rest_mesh, options, m_model),
+      m_target_volume(enclosed_volume(target.vertices, target.faces)) {
+  // Equilibria to 1e-6 of the force scale: the adjoint gradients are as good as at 1e-7 (same errors
+  // on the bench) and a trial needs one Newton step less.
+  m_settings.relative_tolerance = 1e-6;
+  m_settings.max_iterations = 60;
+  m_settings.cancel = options.cancel;
+  m_settings.deadline_s = options.max_time_s > 0 ? m_start + options.max_time_s : 0.0;
+  m_rest_free.assign(static_cast<size_t>(3 * target.vertex_count()), true);
+  for (int v : options.nozzle_vertices)
+    for (int a = 0; a < 3; ++a) m_rest_free[static_cast<size_t>(3 * v + a)] = false;
+}
+
+DesignResult DesignDriver::begin(DesignMethod method) const {
+  DesignResult result;
+  result.method = method;
+  result.bbox_diag_mm = m_objective.surface().bbox_diagonal_mm();
+  m_objective.list_common_terms(result, !m_options.nozzle_vertices.empty());
+  return result;
+}
+
+bool DesignDriver::inflate_start(const Eigen::VectorXd& rest, DesignResult& result) {
+  // The start's guess: the rest shape blown up to the target's volume; the start inflation fixes the
+  // pressure.
+  m_x = flat(scaled_about_centroid(m_rest_mesh.vertices, std::cbrt(m_target_volume / rest_volume(rest))));
+  m_pressure = 0.0;
+  if (!inflate_by_volume_steps(rest, result)) return false;
+  debug_time("initial inflation");
+  const SurfaceDistanceStats baseline = m_objective.surface().aligned_stats(unflatten(m_x), m_target.vertices);
+  result.baseline_avg_error_mm = baseline.avg_mm;
+  result.baseline_max_error_mm = baseline.max_mm;
+  record(result, 0, baseline, rest);
+  remember_if_best(rest, baseline.avg_mm);
+  debug_time("baseline error");
+  return true;
+}
+
+bool DesignDriver::inflate_by_volume_steps(const Eigen::VectorXd& rest, DesignResult& result) {
+  m_model.set_rest_positions(unflatten(rest));
+  const double start_volume = rest_volume(rest);
+  double reached = start_volume;
+  Eigen::VectorXd x = rest;
+  double pressure = 0.0;
+  double step = m_target_volume - start_volume;
+  while (reached < m_target_volume) {
+    const double next = std::min(m_target_volume, reached + step);
+    Eigen::VectorXd trial = flat(scaled_about_centroid(unflatten(x), std::cbrt(next / enclosed_volume(unflatten(x), m_target.faces))));
+    double trial_pressure = pressure;
+    if (trial_pressure == 0.0) {
+      const Eigen::VectorXd g = m_solver.residual(trial, 0.0);
+      Eigen::VectorXd v = m_model.volume_gradient(trial);
+      trial_pressure = g.dot(v) / v.squaredNorm();
+    }
+    m_last_report = m_solver.solve_volume(trial, trial_pressure, next, m_settings);
+    if (m_last_report.converged) {
+      x = trial;
+      pressure = trial_pressure;
+      reached = next;
+      continue;
+    }
+    if (stopped()) {
+      stop_with(result, m_last_report.message == "cancelled" ? DesignStop::Cancelled : DesignStop::TimeLimit,
+                m_last_report.message + " while inflating the start");
+      return false;
+    }
+    if (step < 1e-3 * (m_target_volume - start_volume)) {
+      stop_with(result, DesignStop::StartFailed,
+                "the start shape could not be inflated to the target volume (" + m_last_report.message + ")");
+      return false;
+    }
+    step *= 0.5;
+  }
+  // Place the inflated start on the target (a rigid motion of an equilibrium is one): the pinned
+  // coordinates then hold it in the target's frame, where E_surf and the errors are measured. A
+  // perturbed or user-given start need not inflate in place.
+  m_x = flat(rigid_align_to(unflatten(x), m_target.vertices));
+  m_pressure = pressure;
+  return true;
+}
+
+bool DesignDriver::resume_from(const DesignCheckpoint& checkpoint, Eigen::VectorXd& rest) {
+  if (checkpoint.rest.rows() != m_target.vertex_count() || checkpoint.rest.cols() != 3 ||
+      !checkpoint.rest.allFinite() || checkpoint.iteration < 1 || checkpoint.iteration >= m_options.max_iterations)
+    return false;
+  Eigen::VectorXd goal = flat(checkpoint.rest);
+  for (int c = 0; c < goal.size(); ++c)
+    if (!m_rest_free[static_cast<size_t>(c)]) goal[c] = rest[c];  // the nozzle stays where the start has it
+  goal = keep_rest_volume(goal, rest_volume(rest));
+  Eigen::VectorXd x = m_x;
+  double pressure = m_pressure;
+  for (int step = 1; step <= RESUME_STEPS; ++step) {
+    const double t = static_cast<double>(step) / RESUME_STEPS;
+    m_model.set_rest_positions(unflatten(Eigen::VectorXd((1.0 - t) * rest + t * goal)));
+    m_last_report = m_solver.solve_volume(x, pressure, m_target_volume, m_settings);
+    if (!m_last_report.converged) {
+      m_model.set_rest_positions(unflatten(rest));
+      return false;
+    }
+  }
+  rest = goal;
+  m_x = x;
+  m_pressure = pressure;
+  return true;
+}
+
+bool DesignDriver::equilibrium(const Eigen::VectorXd& rest, Eigen::VectorXd& x, double& pressure) {
+  m_model.set_rest_positions(unflatten(rest));
+  // A trial starts a first-order step from its solution; one that needs many Newton steps has entered
+  // a wrinkling region, and a shorter step is cheaper than following the slow path to the end.
+  NewtonSettings settings = m_settings;
+  settings.max_iterations = TRIAL_NEWTON_ITERATIONS;
+  m_last_report = m_solver.solve_volume(x, pressure, m_target_volume, settings);
+  return m_last_report.converged;
+}
+
+bool DesignDriver::stopped() const {
+  return m_last_report.stop == NewtonStop::Cancelled || m_last_report.stop == NewtonStop::TimeLimit;
+}
+
+Eigen::VectorXd DesignDriver::keep_rest_volume(Eigen::VectorXd rest, double volume) const {
+  for (int pass = 0; pass < 2; ++pass) {
+    Eigen::VectorXd w = m_model.volume_gradient(rest);
+    for (int c = 0; c < w.size(); ++c)
+      if (!m_rest_free[static_cast<size_t>(c)]) w[c] = 0.0;
+    rest += ((volume - rest_volume(rest)) / w.squaredNorm()) * w;
+  }
+  return rest;
+}
+
+double DesignDriver::rest_volume(const Eigen::VectorXd& rest) const {
+  return enclosed_volume(unflatten(rest), m_target.faces);
+}
+
+void DesignDriver::record(DesignResult& result, int iteration, const SurfaceDistanceStats& stats, const Eigen::VectorXd& rest) {
+  ConvergenceSample sample;
+  sample.time_s = design_clock_s() - m_start;
+  sample.iteration = iteration;
+  sample.avg_error_mm = stats.avg_mm;
+  sample.max_error_mm = stats.max_mm;
+  sample.residual_norm = m_last_report.residual_norm;
+  result.log.push_back(sample);
+  if (!m_options.progress) return;
+  ProgressEvent event;
+  event.phase = iteration == 0 ? "start" : "design";
+  event.iteration = iteration;
+  event.elapsed_s = sample.time_s;
+  event.avg_error_mm = stats.avg_mm;
+  event.max_error_mm = stats.max_mm;
+  event.residual_norm = sample.residual_norm;
+  event.pressure_kpa = m_pressure / MPA_PER_KPA;
+  Positions shape;
+  const int every = std::max(1, m_options.progress_mesh_every);
+  if (iteration % every == 0) {
+    shape = rigid_align_to(unflatten(m_x), m_target.vertices);
+    event.shape = &shape;
+  }
+  const Positions rest_shape = unflatten(rest);
+  event.rest_shape = &rest_shape;
+  m_options.progress(event);
+}
+
+void DesignDriver::remember_if_best(const Eigen::VectorXd& rest, double avg_error) {
+  if (avg_error >= m_best_error) return;
+  m_best_error = avg_error;
+  m_best_rest = rest;
+  m_best_x = m_x;
+  m_best_pressure = m_pressure;
+}
+
+void DesignDriver::restore_best(Eigen::VectorXd& rest) {
+  // E_dist and the surface error mostly fall together; where they part, hand back the design with
+  // the smallest average surface error seen (the log still shows every iterate).
+  if (m_best_error < std::numeric_limits<double>::infinity() && m_best_rest.size() == rest.size()) {
+    const double current = m_objective.surface().aligned_stats(unflatten(m_x), m_target.vertices).avg_mm;
+    if (m_best_error < current) {
+      rest = m_best_rest;
+      m_x = m_best_x;
+      m_pressure = m_best_pressure;
+    }
+  }
+}
+
+DesignResult& DesignDriver::finish(DesignResult& result, const Eigen::VectorXd& rest) {
+  result.rest = m_target;
+  result.rest.vertices = unflatten(rest);
+  result.time_s = design_clock_s() - m_start;
+  const bool inflated = !result.log.empty();
+  result.converged = inflated && m_final_equilibrium &&
+                     (result.stop == DesignStop::Matched || result.stop == DesignStop::Optimal);
+  if (!inflated) {
+    result.inflated = result.rest.vertices;
+    return result;
+  }
+  result.inflated = rigid_align_to(unflatten(m_x), m_target.vertices);
+  result.pressure_kpa = m_pressure / MPA_PER_KPA;
+  result.volume_ratio = enclosed_volume(unflatten(m_x), m_target.faces) / rest_volume(rest);
+  const SurfaceDistanceStats stats = m_objective.surface().aligned_stats(unflatten(m_x), m_target.vertices);
+  result.avg_error_mm = stats.avg_mm;
+  result.max_error_mm = stats.max_mm;
+  result.avg_error_rel = stats.avg_rel;
+  result.max_error_rel = stats.max_rel;
+  result.distance_energy = m_objective.distance().value(m_x);
+  m_model.set_rest_positions(result.rest.vertices);
+  result.residual_norm = m_solver.residual(m_x, m_pressure).norm();
+  return result;
+}
+
+void DesignDriver::debug_time(const char* what) const {
+  if (std::getenv("BALLOON_DEBUG_DESIGN")) std::fprintf(stderr, "  %s done at %.2f s\n", what, design_clock_s() - m_start);
+}
+
+}  // namespace balloon

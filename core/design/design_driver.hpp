@@ -1,0 +1,113 @@
+#pragma once
+/// One design run's shared state and the steps both optimizers take: the start shape, its inflation by
+/// volume steps (a continuation in the inflated volume), resuming from a checkpoint (a continuation in the
+/// rest shape), trial equilibria, the progress log, the best design seen and the result. The optimizers
+/// (reduced_space_design.hpp, augmented_lagrangian_design.hpp) move the rest shape; the driver keeps the
+/// current equilibrium (x, pressure) of it.
+#include <Eigen/Core>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "design/adjoint_sensitivity.hpp"
+#include "design/balloon_design.hpp"
+#include "design/design_objective.hpp"
+#include "fem/balloon_model.hpp"
+#include "solve/equilibrium_solver.hpp"
+
+namespace balloon {
+
+constexpr double MPA_PER_KPA = 1e-3;
+
+/// Steady-clock seconds (the clock of NewtonSettings::deadline_s).
+double design_clock_s();
+
+/// Sets the stop reason and its sentence.
+void stop_with(DesignResult& result, DesignStop stop, std::string message);
+
+class DesignDriver {
+ public:
+  /// `target` and `options` must outlive the driver (options' callbacks and cancel token included).
+  DesignDriver(const TriMesh& target, const DesignOptions& options);
+  DesignDriver(const DesignDriver&) = delete;
+  DesignDriver& operator=(const DesignDriver&) = delete;
+
+  const TriMesh& target() const { return m_target; }
+  const DesignOptions& options() const { return m_options; }
+  /// The start rest shape (the downscaled target, or the given initial rest shape rescaled).
+  const TriMesh& start() const { return m_rest_mesh; }
+  fem::BalloonModel& model() { return m_model; }
+  EquilibriumSolver& solver() { return m_solver; }
+  /// dx/drest at the current equilibrium: the gradient and the predictor.
+  AdjointSensitivity& sensitivity() { return m_sensitivity; }
+  DesignObjective& objective() { return m_objective; }
+  const NewtonSettings& settings() const { return m_settings; }
+  /// 3#V flags: false for rest coordinates the nozzle holds.
+  const std::vector<bool>& rest_free() const { return m_rest_free; }
+  double target_volume() const { return m_target_volume; }
+  double start_time() const { return m_start; }
+
+  /// The current inflated shape (3#V, mm, target frame), its pressure (MPa) and the last Newton report.
+  Eigen::VectorXd& x() { return m_x; }
+  double& pressure() { return m_pressure; }
+  NewtonReport& last_report() { return m_last_report; }
+
+  /// A result for `method` with the target's diagonal and the shared active terms.
+  DesignResult begin(DesignMethod method) const;
+  /// Inflates the start `rest` to the target's volume (by volume steps when one step is too far), places
+  /// it on the target, and records the baseline as iteration 0. False (result stop set) when it fails.
+  bool inflate_start(const Eigen::VectorXd& rest, DesignResult& result);
+  /// Brings a checkpoint's rest shape (at this design's rest volume) to equilibrium from the inflated
+  /// start, through rest shapes blended from the start's. On success `rest`, x and pressure are the
+  /// checkpoint's; otherwise nothing changes.
+  bool resume_from(const DesignCheckpoint& checkpoint, Eigen::VectorXd& rest);
+  /// Volume-controlled equilibrium of `rest` from (x, p) with a short Newton budget; false when it does
+  /// not converge (last_report() says why).
+  bool equilibrium(const Eigen::VectorXd& rest, Eigen::VectorXd& x, double& pressure);
+  /// Whether the last Newton solve stopped on the cancel token or the deadline.
+  bool stopped() const;
+
+  /// Restores the rest volume after a step, moving only free vertices along the volume gradient.
+  Eigen::VectorXd keep_rest_volume(Eigen::VectorXd rest, double volume) const;
+  double rest_volume(const Eigen::VectorXd& rest) const;
+
+  /// Appends a log row and sends a progress event for the current equilibrium of `rest`.
+  void record(DesignResult& result, int iteration, const SurfaceDistanceStats& stats, const Eigen::VectorXd& rest);
+  /// Keeps (rest, x, pressure) when `avg_error` is the smallest seen.
+  void remember_if_best(const Eigen::VectorXd& rest, double avg_error);
+  /// Goes back to the best design seen when its average surface error is below the current one's.
+  void restore_best(Eigen::VectorXd& rest);
+  /// Whether the returned shape is an equilibrium (alm: whether its final re-inflation converged).
+  void set_final_equilibrium(bool converged) { m_final_equilibrium = converged; }
+  /// The result's shapes and errors. Without an inflated start (start_failed, or stopped before it)
+  /// there is no design: the errors stay empty, the rest shape is the start, nothing is called converged.
+  DesignResult& finish(DesignResult& result, const Eigen::VectorXd& rest);
+
+  /// With BALLOON_DEBUG_DESIGN set, prints the time since the start after `what` (stderr).
+  void debug_time(const char* what) const;
+
+ private:
+  /// The start's inflation from x to the target's volume, by volume steps when one step is too far.
+  bool inflate_by_volume_steps(const Eigen::VectorXd& rest, DesignResult& result);
+
+  const TriMesh& m_target;
+  const DesignOptions& m_options;
+  double m_start;
+  TriMesh m_rest_mesh;
+  fem::BalloonModel m_model;
+  EquilibriumSolver m_solver;
+  AdjointSensitivity m_sensitivity;
+  DesignObjective m_objective;
+  double m_target_volume;
+  std::vector<bool> m_rest_free;
+  NewtonSettings m_settings;
+  NewtonReport m_last_report;
+  Eigen::VectorXd m_x;
+  double m_pressure = 0.0;
+  double m_best_error = std::numeric_limits<double>::infinity();
+  Eigen::VectorXd m_best_rest, m_best_x;
+  double m_best_pressure = 0.0;
+  bool m_final_equilibrium = true;
+};
+
+}  // namespace balloon

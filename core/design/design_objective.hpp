@@ -1,0 +1,84 @@
+#pragma once
+/// The design objective and its terms (paper sec. 5): E_dist(x) (eq. 18) against the target, the surface
+/// term E_surf(x) (the error the result reports), and the rest-shape regularizers R(rest) that join only
+/// when the scene needs them: rest collisions (eq. 24), rest bending against the start (flat starts), and
+/// the maximum-volume term (alm, once a rest region has turned inside out). Both optimizers minimise
+/// value(rest, x) with x the inflated shape of rest; they differ in how they keep x an equilibrium.
+/// Positions are flat 3#V vectors (mm).
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <memory>
+#include <vector>
+
+#include "design/balloon_design.hpp"
+#include "design/distance_energy.hpp"
+#include "design/self_collision.hpp"
+#include "design/surface_distance.hpp"
+#include "fem/balloon_model.hpp"
+
+namespace balloon {
+
+class DesignObjective {
+ public:
+  /// `target` is the shape to reach, `start` the start rest shape (its hinges are the rest-bending
+  /// reference, its edges the collision scale); `model` gives the rest volume's gradient. `target` and
+  /// `model` must outlive this object.
+  DesignObjective(const TriMesh& target, const TriMesh& start, const DesignOptions& options,
+                  const fem::BalloonModel& model);
+
+  /// E_dist + E_surf at x plus the active regularizers at rest.
+  double value(const Eigen::VectorXd& rest, const Eigen::VectorXd& x) const;
+  /// d(E_dist + E_surf)/dx (3#V).
+  Eigen::VectorXd shape_gradient(const Eigen::VectorXd& x) const;
+  /// E_surf at x; its gradient into `gradient` when given.
+  double surface_term(const Eigen::VectorXd& x, Eigen::VectorXd* gradient) const;
+
+  /// The rest-shape terms that are active: collisions, rest bending, maximum volume.
+  double regularizer_value(const Eigen::VectorXd& rest) const;
+  /// Adds the gradient of regularizer_value to `gradient`.
+  void add_regularizer_gradient(const Eigen::VectorXd& rest, Eigen::Ref<Eigen::VectorXd> gradient) const;
+
+  /// Gauss-Newton Hessian of E_surf, point-to-plane, as triplets shifted by dof_offset.
+  void add_surface_hessian(const Eigen::VectorXd& x, std::vector<Eigen::Triplet<double>>& triplets,
+                           int dof_offset) const;
+
+  /// Updates the colliding rest pairs at `rest` (once per accepted step) and lists "collision" in
+  /// `result` the first time any is near. True when the collision term was or is on, i.e. value() at
+  /// rest may differ from before the update.
+  bool update_collisions(const Eigen::VectorXd& rest, DesignResult& result);
+
+  /// Once a rest region has turned inside out, the maximum-volume term (paper sec. 5.2) joins the
+  /// objective, weighted so that a 1% volume change is worth 1% of the start's E_dist.
+  void update_max_volume_term(const Eigen::VectorXd& rest, double start_distance, DesignResult& result);
+
+  /// Moves the inflated shape x rigidly onto the target (vertex correspondence) when that moves it by
+  /// more than a 1e-4 of the diagonal on average, and says whether it did. Only E_surf cares where the
+  /// shape sits; the pinned coordinates otherwise keep the start's placement.
+  bool realign(Eigen::VectorXd& x) const;
+
+  /// Active terms every method shares (the method adds its own).
+  void list_common_terms(DesignResult& result, bool nozzle) const;
+
+  const DistanceEnergy& distance() const { return m_distance; }
+  const DistanceEnergy& start_hinges() const { return m_start_hinges; }
+  const SurfaceDistance& surface() const { return m_surface; }
+  bool rest_bending_active() const { return m_rest_bending_active; }
+
+ private:
+  /// Hinges of `rest` whose dihedral angle moved more than a right angle from the start's.
+  int inverted_hinges(const Eigen::VectorXd& rest) const;
+
+  const TriMesh& m_target;
+  const fem::BalloonModel& m_model;
+  DistanceEnergy m_distance;
+  SurfaceDistance m_surface;
+  DistanceEnergy m_start_hinges;  ///< the start's hinge angles; with k_length 0 it is the rest-bending term
+  std::unique_ptr<SelfCollision> m_collision;
+  bool m_collision_seen = false;
+  bool m_rest_bending_active = false;
+  double m_surface_weight = 0.0;     ///< w of E_surf = w sum_i d_i^2 (mm^-1); 0 when k_surface is 0
+  double m_max_volume_weight = 0.0;  ///< alm: weight of -V(rest) once a region turned inside out (mm^-2)
+  double m_start_volume = 0.0;       ///< the start's rest volume (mm^3)
+};
+
+}  // namespace balloon

@@ -1,0 +1,299 @@
+#include "design/reduced_space_design.hpp"
+
+#include <Eigen/SparseCore>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "design/adjoint_sensitivity.hpp"
+#include "design/design_objective.hpp"
+#include "design/distance_energy.hpp"
+#include "design/lbfgs.hpp"
+#include "design/surface_distance.hpp"
+#include "solve/equilibrium_solver.hpp"
+
+namespace balloon {
+
+namespace {
+
+/// The adjoint method stops when neither the average surface error (what the maker sees) nor the
+/// objective has improved by STALL_IMPROVEMENT (relative) in STALL_ITERATIONS iterations, or when the
+/// average error is below MATCH_TOLERANCE_REL of the target's diagonal (0.01 mm on 100 mm, far below
+/// what a 3D printer or a brushed silicone layer reproduces).
+constexpr double STALL_IMPROVEMENT = 0.01;
+constexpr int STALL_ITERATIONS = 15;
+/// While the objective still falls by this much per STALL_ITERATIONS, a design whose error rose for a
+/// while (reshaping a perturbed start) is not stalled.
+constexpr double STALL_OBJECTIVE_DECREASE = 0.1;
+constexpr double MATCH_TOLERANCE_REL = 1e-4;
+/// First-order optimality: the design gradient below this fraction of its value at the start.
+constexpr double OPTIMALITY_TOLERANCE = 1e-6;
+
+/// A fraction as a short human string: 0.01 -> "1%", 1e-4 -> "1e-04".
+std::string format_fraction(double fraction) {
+  char text[32];
+  if (fraction >= 0.01) std::snprintf(text, sizeof(text), "%g%%", 100.0 * fraction);
+  else std::snprintf(text, sizeof(text), "%.0e", fraction);
+  return text;
+}
+
+/// A ratio as a short human string: 131.4 -> "131x", 0.002 -> "0.002x".
+std::string format_ratio(double ratio) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.3gx", ratio);
+  return text;
+}
+
+/// Reduced-space design: the inflated shape x is the volume-controlled equilibrium of the rest shape,
+/// warm-started from the previous one; the gradient of E_dist(x(rest)) comes from one adjoint solve of
+/// the bordered equilibrium system with the Hessian factorized at the equilibrium; L-BFGS outside.
+class ReducedSpaceDesign {
+ public:
+  explicit ReducedSpaceDesign(DesignDriver& driver)
+      : m_driver(driver),
+        m_target(driver.target()),
+        m_options(driver.options()),
+        m_model(driver.model()),
+        m_solver(driver.solver()),
+        m_sensitivity(driver.sensitivity()),
+        m_objective(driver.objective()),
+        m_distance(driver.objective().distance()),
+        m_surface(driver.objective().surface()),
+        m_settings(driver.settings()),
+        m_rest_free(driver.rest_free()),
+        m_target_volume(driver.target_volume()),
+        m_x(driver.x()),
+        m_pressure(driver.pressure()),
+        m_last_report(driver.last_report()) {}
+
+  DesignResult run() {
+    DesignResult result = m_driver.begin(DesignMethod::Adjoint);
+    result.active_terms.push_back("fixed_rest_volume");
+
+    // Start: inflate the downscaled target to the target's volume; that fixes the inflation.
+    Eigen::VectorXd rest = flat(m_driver.start().vertices);
+    if (!m_driver.inflate_start(rest, result)) return m_driver.finish(result, rest);
+    int first_iteration = 1;
+    double stall_reference = *result.baseline_avg_error_mm;  // best surface error at the last real improvement (mm)
+    if (m_options.resume && m_driver.resume_from(*m_options.resume, rest)) {
+      result.resumed_from_iteration = m_options.resume->iteration;
+      first_iteration = m_options.resume->iteration + 1;
+      const SurfaceDistanceStats resumed = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
+      m_driver.record(result, m_options.resume->iteration, resumed, rest);
+      m_driver.remember_if_best(rest, resumed.avg_mm);
+      stall_reference = resumed.avg_mm;
+      m_driver.debug_time("resumed from the checkpoint");
+    }
+    Eigen::VectorXd gradient;
+    double objective = m_objective.value(rest, m_x);
+    if (!objective_gradient(rest, gradient)) {
+      stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized at the start");
+      return m_driver.finish(result, rest);
+    }
+    const double initial_gradient_norm = gradient.norm();
+    const double initial_objective = objective;
+    build_preconditioner();
+    m_driver.debug_time("first gradient and preconditioner");
+    int small_decreases = 0;
+    double stall_objective = objective;         // objective at the last real improvement of either
+    int stall_iteration = first_iteration - 1;
+    const double max_radius = 0.02 * result.bbox_diag_mm;  // mm
+    double radius = max_radius;
+    stop_with(result, DesignStop::IterationLimit, "iteration limit reached");
+    for (int iteration = first_iteration; iteration <= m_options.max_iterations; ++iteration) {
+      if (m_options.cancel && m_options.cancel->cancelled()) {
+        stop_with(result, DesignStop::Cancelled, "cancelled");
+        break;
+      }
+      if (m_settings.deadline_s > 0 && design_clock_s() > m_settings.deadline_s) {
+        stop_with(result, DesignStop::TimeLimit, "time limit reached");
+        break;
+      }
+      Eigen::VectorXd direction = -m_lbfgs.apply(gradient);
+      for (int c = 0; c < direction.size(); ++c)
+        if (!m_rest_free[static_cast<size_t>(c)]) direction[c] = 0.0;
+      if (!(direction.dot(gradient) < 0.0)) {
+        m_lbfgs.clear();
+        direction = -gradient;
+      }
+      // Trust region on the rest shape: no vertex moves more than `radius` (at most 2% of the target's
+      // size) per step. The radius shrinks to the last step that needed halving and grows back after
+      // full steps, so a wrinkling region costs one failed equilibrium, not one per iteration.
+      const double largest = unflatten(direction).rowwise().norm().maxCoeff();
+      double t = largest > radius ? radius / largest : 1.0;
+      const double first_t = t;
+      if (m_lbfgs.empty()) t = std::min(t, 0.002 * result.bbox_diag_mm / std::max(largest, 1e-300));
+      const double slope = direction.dot(gradient);
+      // First-order response of the equilibrium to the rest step, from the factorization the gradient
+      // just used: each trial starts Newton a second-order distance from its solution.
+      Eigen::VectorXd response;
+      double pressure_response = 0.0;
+      m_sensitivity.linear_response(direction, response, pressure_response);
+      bool accepted = false;
+      Eigen::VectorXd trial_rest, trial_x;
+      double trial_pressure = 0.0, trial_objective = 0.0;
+      for (int k = 0; k < 12; ++k, t *= 0.5) {
+        trial_rest = m_driver.keep_rest_volume(rest + t * direction, m_driver.rest_volume(rest));
+        trial_x = m_x + t * response;
+        trial_pressure = m_pressure + t * pressure_response;
+        const bool balanced = m_driver.equilibrium(trial_rest, trial_x, trial_pressure);
+        if (std::getenv("BALLOON_DEBUG_DESIGN"))
+          std::fprintf(stderr, "  it %d trial %d t=%.3g newton %d %s (%.2f s)\n", iteration, k, t,
+                       m_last_report.iterations, m_last_report.message.c_str(), design_clock_s() - m_driver.start_time());
+        if (!balanced) {
+          if (m_driver.stopped()) break;
+          continue;
+        }
+        trial_objective = m_objective.value(trial_rest, trial_x);
+        if (trial_objective <= objective + 1e-4 * t * slope) {
+          accepted = true;
+          break;
+        }
+      }
+      if (!accepted) {
+        if (m_driver.stopped()) {
+          stop_with(result, m_last_report.message == "cancelled" ? DesignStop::Cancelled : DesignStop::TimeLimit,
+                    m_last_report.message);
+          break;
+        }
+        if (!m_lbfgs.empty()) {  // a stale curvature model: restart from steepest descent
+          m_lbfgs.clear();
+          continue;
+        }
+        // A failed line search is optimality only where the gradient has vanished; elsewhere it is a stall
+        // (a wrinkling region no trial step could balance, say), and says so.
+        if (gradient.norm() <= OPTIMALITY_TOLERANCE * initial_gradient_norm) {
+          stop_with(result, DesignStop::Optimal, "optimal: the design gradient fell below " +
+                                                     format_fraction(OPTIMALITY_TOLERANCE) + " of its start value");
+        } else {
+          stop_with(result, DesignStop::Stalled,
+                    "stalled: no decrease along the steepest descent (design gradient at " +
+                        format_ratio(gradient.norm() / initial_gradient_norm) + " its start value)");
+        }
+        break;
+      }
+      radius = t < first_t ? t * largest : std::min(max_radius, 2.0 * radius);
+      const Eigen::VectorXd step = trial_rest - rest;
+      rest = trial_rest;
+      m_x = trial_x;
+      m_pressure = trial_pressure;
+      const bool collisions_changed = m_objective.update_collisions(rest, result);
+      Eigen::VectorXd new_gradient;
+      // The line search already evaluated this point; only a changed set of colliding pairs alters it.
+      objective = collisions_changed ? m_objective.value(rest, m_x) : trial_objective;
+      if (!objective_gradient(rest, new_gradient)) {
+        stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized");
+        break;
+      }
+      m_driver.debug_time("gradient");
+      const Eigen::VectorXd change = new_gradient - gradient;
+      m_lbfgs.update(step, change);
+      gradient = new_gradient;
+      const SurfaceDistanceStats stats = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
+      m_driver.record(result, iteration, stats, rest);
+      m_driver.remember_if_best(rest, stats.avg_mm);
+      result.iterations = iteration;
+      m_driver.debug_time("surface error");
+      const double relative_decrease = -t * slope / std::max(initial_objective, 1e-300);
+      small_decreases = relative_decrease < 1e-7 ? small_decreases + 1 : 0;
+      if (stats.avg_rel < MATCH_TOLERANCE_REL) {
+        stop_with(result, DesignStop::Matched, "matched: the inflated shape matches the target to " +
+                                                   format_fraction(MATCH_TOLERANCE_REL) + " of its bounding-box diagonal");
+        break;
+      }
+      if (objective <= 1e-14 * initial_objective || gradient.norm() <= OPTIMALITY_TOLERANCE * initial_gradient_norm) {
+        stop_with(result, DesignStop::Optimal, "optimal: the design gradient fell below " +
+                                                   format_fraction(OPTIMALITY_TOLERANCE) + " of its start value");
+        break;
+      }
+      if (small_decreases >= 3) {
+        stop_with(result, DesignStop::Stalled, "stalled: the objective fell by less than 1e-7 in 3 iterations");
+        break;
+      }
+      if (stats.avg_mm < (1.0 - STALL_IMPROVEMENT) * stall_reference) {
+        stall_reference = stats.avg_mm;
+        stall_iteration = iteration;
+        stall_objective = objective;
+      } else if (objective < (1.0 - STALL_OBJECTIVE_DECREASE) * stall_objective) {
+        stall_iteration = iteration;  // the error may rise for a while as the objective reshapes the balloon
+        stall_objective = objective;
+      } else if (iteration - stall_iteration >= STALL_ITERATIONS && m_objective.realign(m_x)) {
+        // The pinned coordinates held the shape where the start put it; re-placed on the target, the
+        // surface term can pull again. A rigid motion of an equilibrium is one: only the gauge changed.
+        m_lbfgs.clear();
+        stall_iteration = iteration;
+        objective = m_objective.value(rest, m_x);
+        stall_objective = objective;
+        if (!objective_gradient(rest, gradient)) {
+          stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized");
+          break;
+        }
+      } else if (iteration - stall_iteration >= STALL_ITERATIONS) {
+        stop_with(result, DesignStop::Stalled, "stalled: the surface error improved less than " +
+                                                   format_fraction(STALL_IMPROVEMENT) + " in the last " +
+                                                   std::to_string(STALL_ITERATIONS) + " iterations");
+        break;
+      }
+    }
+    m_driver.restore_best(rest);
+    return m_driver.finish(result, rest);
+  }
+
+ private:
+  /// d objective / d rest through the adjoint of the bordered equilibrium system at (m_x, m_pressure):
+  /// [K -v; -v^T 0] [lambda; mu] = [dE/dx; 0], gradient = -(d grad_x W / d rest)^T lambda.
+  bool objective_gradient(const Eigen::VectorXd& rest, Eigen::VectorXd& gradient) {
+    m_model.set_rest_positions(unflatten(rest));
+    if (!m_sensitivity.prepare(rest, m_x, m_pressure)) return false;
+    gradient = m_sensitivity.gradient(m_objective.shape_gradient(m_x));
+    m_objective.add_regularizer_gradient(rest, gradient);
+    for (int c = 0; c < gradient.size(); ++c)
+      if (!m_rest_free[static_cast<size_t>(c)]) gradient[c] = 0.0;
+    // The rest volume stays at target volume / volume ratio: with the inflated volume fixed, a uniform
+    // change of rest size barely changes the inflated shape, so without this the asked-for inflation
+    // would drift. Project out the rest-volume gradient.
+    Eigen::VectorXd w = m_model.volume_gradient(rest);
+    for (int c = 0; c < w.size(); ++c)
+      if (!m_rest_free[static_cast<size_t>(c)]) w[c] = 0.0;
+    gradient -= (gradient.dot(w) / w.squaredNorm()) * w;
+    return gradient.allFinite();
+  }
+
+  /// L-BFGS's initial inverse Hessian: the Gauss-Newton Hessian of E_dist at the start's inflation,
+  /// factorized once. The rest-to-inflated map is close to a scaling, so this is the shape of the
+  /// objective's curvature in rest coordinates; L-BFGS corrects the rest.
+  void build_preconditioner() {
+    std::vector<Eigen::Triplet<double>> entries;
+    m_distance.hessian_triplets(m_x, entries, DistanceHessian::GaussNewton);
+    m_objective.add_surface_hessian(m_x, entries, 0);
+    Eigen::SparseMatrix<double> hessian(m_x.size(), m_x.size());
+    hessian.setFromTriplets(entries.begin(), entries.end());
+    m_lbfgs.set_preconditioner(std::move(hessian));
+  }
+
+  DesignDriver& m_driver;
+  const TriMesh& m_target;
+  const DesignOptions& m_options;
+  fem::BalloonModel& m_model;
+  EquilibriumSolver& m_solver;
+  AdjointSensitivity& m_sensitivity;
+  DesignObjective& m_objective;
+  const DistanceEnergy& m_distance;
+  const SurfaceDistance& m_surface;
+  const NewtonSettings& m_settings;
+  const std::vector<bool>& m_rest_free;
+  const double m_target_volume;
+  Eigen::VectorXd& m_x;           ///< the driver's current equilibrium
+  double& m_pressure;
+  NewtonReport& m_last_report;
+  Lbfgs m_lbfgs{30};  ///< L-BFGS on the rest shape: (s, y) pairs of the last 30 accepted steps
+};
+
+}  // namespace
+
+DesignResult run_reduced_space_design(DesignDriver& driver) { return ReducedSpaceDesign(driver).run(); }
+
+}  // namespace balloon
