@@ -22,17 +22,18 @@ ServiceStatus load_simulate(const v1::SimulateJob& job, const std::string& tenan
   parameters.thickness_mm = job.thickness_mm() == 0.0 ? jobs::DEFAULT_THICKNESS_MM : job.thickness_mm();
   if (job.control_case() == v1::SimulateJob::kPressureKpa) parameters.pressure_kpa = job.pressure_kpa();
   if (job.control_case() == v1::SimulateJob::kVolumeRatio) parameters.volume_ratio = job.volume_ratio();
-  // Checked here first so that each bad field is named; prepare_simulate checks them again.
+  // The parameters and the material are checked here first, each bad field by name (prepare_simulate
+  // checks them again), so what prepare_simulate still refuses is the mesh.
   if (const std::vector<jobs::FieldProblem> problems = jobs::simulate_parameter_problems(parameters); !problems.empty())
     return bad_fields(problems);
+  if (const std::string problem = material_problem(*material); !problem.empty())
+    return ServiceStatus::bad_field("material", "material: " + problem);
   Result<jobs::SimulateInput> input = jobs::prepare_simulate(std::move(mesh), *material, parameters);
   if (!input) {
-    // prepare_simulate prefixes mesh problems with "mesh: " and material ones with "material: "; name the
-    // field the caller knows.
+    // prepare_simulate prefixes mesh problems with "mesh: "; name the field the caller knows.
     std::string message = input.error();
-    if (message.rfind("mesh: ", 0) == 0) return ServiceStatus::bad_field("rest_mesh", "rest_" + message);
-    if (message.rfind("material: ", 0) == 0) return ServiceStatus::bad_field("material", message);
-    return ServiceStatus::error(StatusCode::InvalidArgument, message);
+    if (message.rfind("mesh: ", 0) == 0) message = "rest_" + message;
+    return ServiceStatus::bad_field("rest_mesh", message);
   }
   *loaded = std::move(*input);
   return ServiceStatus::success();
