@@ -16,6 +16,7 @@
 #include "contract/job_result_files.hpp"
 #include "design/balloon_design.hpp"
 #include "exit_codes.hpp"
+#include "field_flags.hpp"
 #include "jobs/design_job.hpp"
 #include "job_watch.hpp"
 #include "material/material.hpp"
@@ -128,7 +129,8 @@ Result<v1::SubmitJobRequest> design_request_from_args(const ParsedArgs& args) {
     if (text->empty()) return fail("--nozzle: give auto or X,Y,Z[,RADIUS] (mm)");
     parameters.nozzle = *text;
   }
-  if (const std::string found = jobs::design_parameters_problem(parameters); !found.empty()) return fail(found);
+  if (const std::vector<jobs::FieldProblem> found = jobs::design_parameter_problems(parameters); !found.empty())
+    return fail(message_naming_flags("design", found));
 
   job->set_thickness_mm(parameters.thickness_mm);
   job->set_size_mm(parameters.size_mm);
@@ -208,7 +210,7 @@ Result<PreparedJob> prepare_design(const std::vector<std::string>& args) {
   PreparedJob job;
   job.request = std::move(*request);
   job.args = std::move(*parsed);
-  job.file_field = "target_mesh";
+  job.file_field = "design.target_mesh";
   job.file_path = job.args.positionals.front();
   return job;
 }

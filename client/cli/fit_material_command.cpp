@@ -149,12 +149,7 @@ Result<PreparedJob> prepare_fit_material(const std::vector<std::string>& args) {
     set->set_label(file.label);
   }
   fit->set_model(*parsed->get("model"));
-  if (const auto name = parsed->get("name")) {
-    fit->set_name(*name);
-    // A refused name is the --name's problem: the service's message then starts with the field.
-    job.file_field = "name";
-    job.file_path = "--name " + *name;
-  }
+  if (const auto name = parsed->get("name")) fit->set_name(*name);
   job.args = std::move(*parsed);
   job.context = std::make_shared<const FitContext>(FitContext{std::move(*input)});
   return job;

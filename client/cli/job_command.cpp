@@ -10,6 +10,7 @@
 #include "cli_output.hpp"
 #include "design_progress.hpp"
 #include "exit_codes.hpp"
+#include "field_flags.hpp"
 
 namespace balloon::cli {
 namespace {
@@ -102,7 +103,7 @@ int run_job_command(const JobCommand& command, const std::vector<std::string>& a
 
   v1::SubmitJobResponse submitted;
   if (const grpc::Status status = (*connection)->submit(prepared->request, &submitted); !status.ok())
-    return report_error(name, message_naming_file(status, prepared->file_field, prepared->file_path),
+    return report_error(name, message_naming_fields(status, prepared->file_field, prepared->file_path),
                         exit_code_for(status));
   const std::string job_id = submitted.job().id();
 

@@ -20,7 +20,7 @@ namespace balloon::cli {
 struct PreparedJob {
   balloon::v1::SubmitJobRequest request;
   ParsedArgs args;         ///< the command's own parsed options (its output flags, for `finish`)
-  std::string file_field;  ///< the request field that carries the user's file ("target_mesh"), for errors
+  std::string file_field;  ///< path of the request field that carries the user's file ("design.target_mesh"), for errors
   std::string file_path;   ///< that file
   std::any context;        ///< what `finish` needs beyond the args (the fit's checked data)
 };

@@ -8,6 +8,7 @@
 #include "cli_output.hpp"
 #include "commands.hpp"
 #include "exit_codes.hpp"
+#include "field_flags.hpp"
 #include "service_connection.hpp"
 
 namespace balloon::cli {
@@ -91,7 +92,7 @@ int run_materials_command(const std::vector<std::string>& args, const GlobalOpti
     request.mutable_material()->set_description(parsed->get("description").value_or(""));
     status = service.stub().PutMaterial(&context, request, &material);
   }
-  if (!status.ok()) return report_error(command, status.error_message(), exit_code_for(status));
+  if (!status.ok()) return report_error(command, message_naming_fields(status), exit_code_for(status));
   if (json)
     std::cout << message_to_json(material) << std::endl;
   else

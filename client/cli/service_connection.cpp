@@ -120,11 +120,6 @@ grpc::Status ServiceConnection::submit(const balloon::v1::SubmitJobRequest& requ
   return status;
 }
 
-std::string message_naming_file(const grpc::Status& status, const std::string& field, const std::string& path) {
-  const std::string& message = status.error_message();
-  return message.rfind(field, 0) == 0 ? "'" + path + "': " + message : message;
-}
-
 int exit_code_for(const grpc::Status& status) {
   switch (status.error_code()) {
     case grpc::StatusCode::OK: return EXIT_OK;

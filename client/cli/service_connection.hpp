@@ -58,8 +58,4 @@ class ServiceConnection {
 /// The CLI exit code for a failed call (exit_codes.hpp).
 int exit_code_for(const grpc::Status& status);
 
-/// The service's message for a failed call, naming the user's file where the message is about the
-/// request field that carried it: "target_mesh: no triangles" -> "'bunny.obj': target_mesh: no triangles".
-std::string message_naming_file(const grpc::Status& status, const std::string& field, const std::string& path);
-
 }  // namespace balloon::cli

@@ -85,7 +85,7 @@ Result<PreparedJob> prepare_simulate(const std::vector<std::string>& args) {
   PreparedJob job;
   job.request = std::move(*request);
   job.args = std::move(*parsed);
-  job.file_field = "rest_mesh";
+  job.file_field = "simulate.rest_mesh";
   job.file_path = job.args.positionals.front();
   return job;
 }

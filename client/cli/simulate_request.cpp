@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "field_flags.hpp"
 #include "jobs/simulate_job.hpp"
 #include "material/material.hpp"
 #include "material_argument.hpp"
@@ -60,7 +61,8 @@ Result<balloon::v1::SubmitJobRequest> simulate_request_from_args(const ParsedArg
     if (!value) return fail(value.error());
     parameters.volume_ratio = *value;
   }
-  if (const std::string problem = jobs::simulate_parameters_problem(parameters); !problem.empty()) return fail(problem);
+  if (const std::vector<jobs::FieldProblem> problems = jobs::simulate_parameter_problems(parameters); !problems.empty())
+    return fail(message_naming_flags("simulate", problems));
   job->set_thickness_mm(parameters.thickness_mm);
   if (parameters.pressure_kpa) job->set_pressure_kpa(*parameters.pressure_kpa);
   if (parameters.volume_ratio) job->set_volume_ratio(*parameters.volume_ratio);

@@ -43,14 +43,16 @@ constexpr auto EVENT_POLL = std::chrono::milliseconds(250);
 bool is_api_path(const std::string& path) { return path == "/api" || path.rfind("/api/", 0) == 0; }
 
 /// The API's error body; `http_status` overrides the status the code maps to (415 has no gRPC code).
-void send_error(httplib::Response& res, grpc::StatusCode code, const std::string& message, int http_status = 0) {
+void send_error(httplib::Response& res, grpc::StatusCode code, const std::string& message, int http_status = 0,
+                const std::string& error_details = "") {
   res.status = http_status != 0 ? http_status : http_status_for(code);
   res.set_header("Cache-Control", "no-store");
-  res.set_content(error_body(code, message), JSON_TYPE);
+  res.set_content(error_body(code, message, error_details), JSON_TYPE);
 }
 
+/// A failed call's status, with the fields its details name (google.rpc.BadRequest) as "fields".
 void send_status(httplib::Response& res, const grpc::Status& status) {
-  send_error(res, status.error_code(), status.error_message());
+  send_error(res, status.error_code(), status.error_message(), 0, status.error_details());
 }
 
 void send_message(httplib::Response& res, const google::protobuf::Message& message) {

@@ -3,6 +3,8 @@
 #include <google/protobuf/message.h>
 #include <google/protobuf/util/json_util.h>
 
+#include "google/rpc/error_details.pb.h"
+#include "google/rpc/status.pb.h"
 #include "jobs/json_writer.hpp"
 
 namespace balloon::http {
@@ -69,14 +71,29 @@ int http_status_for(grpc::StatusCode code) {
   }
 }
 
-std::string status_json(grpc::StatusCode code, const std::string& message) {
+std::string status_json(grpc::StatusCode code, const std::string& message, const std::string& error_details) {
   jobs::JsonWriter json;
-  json.begin_object().value("code", status_code_name(code)).value("message", message).end_object();
+  json.begin_object().value("code", status_code_name(code)).value("message", message);
+  google::rpc::Status details;
+  if (!error_details.empty() && details.ParseFromString(error_details)) {
+    bool open = false;
+    for (const google::protobuf::Any& detail : details.details()) {
+      google::rpc::BadRequest bad_request;
+      if (!detail.UnpackTo(&bad_request)) continue;
+      for (const google::rpc::BadRequest::FieldViolation& violation : bad_request.field_violations()) {
+        if (!open) json.begin_array("fields");
+        open = true;
+        json.begin_object().value("field", violation.field()).value("description", violation.description()).end_object();
+      }
+    }
+    if (open) json.end_array();
+  }
+  json.end_object();
   return json.str();
 }
 
-std::string error_body(grpc::StatusCode code, const std::string& message) {
-  return "{\"error\":" + status_json(code, message) + "}";
+std::string error_body(grpc::StatusCode code, const std::string& message, const std::string& error_details) {
+  return "{\"error\":" + status_json(code, message, error_details) + "}";
 }
 
 }  // namespace balloon::http

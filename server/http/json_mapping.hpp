@@ -1,7 +1,8 @@
 #pragma once
 /// The HTTP gateway's JSON: API messages <-> JSON with protobuf's JSON mapping (proto field names, every
 /// primitive field printed), gRPC status codes -> HTTP statuses, and the error body
-/// `{"error":{"code":"INVALID_ARGUMENT","message":"..."}}`; README.md, "HTTP/JSON API".
+/// `{"error":{"code":"INVALID_ARGUMENT","message":"...","fields":[{"field":"design.thickness_mm",
+/// "description":"..."}]}}`; README.md, "HTTP/JSON API".
 #include <string>
 
 #include <grpcpp/support/status_code_enum.h>
@@ -29,10 +30,13 @@ std::string status_code_name(grpc::StatusCode code);
 /// UNAVAILABLE 503, OK 200, anything else 500.
 int http_status_for(grpc::StatusCode code);
 
-/// `{"code":"<name>","message":"<message>"}` (the payload of an error body and of the SSE end event).
-std::string status_json(grpc::StatusCode code, const std::string& message);
+/// `{"code":"<name>","message":"<message>"}` (the payload of an error body and of the SSE end event), with
+/// `"fields":[{"field":"<path>","description":"<why>"},...]` when `error_details` (a status's details: a
+/// serialized google.rpc.Status) holds google.rpc.BadRequest field violations. Details that do not parse
+/// are left out: the code and message still stand.
+std::string status_json(grpc::StatusCode code, const std::string& message, const std::string& error_details = "");
 
-/// `{"error":{"code":"<name>","message":"<message>"}}`.
-std::string error_body(grpc::StatusCode code, const std::string& message);
+/// `{"error":<status_json>}`.
+std::string error_body(grpc::StatusCode code, const std::string& message, const std::string& error_details = "");
 
 }  // namespace balloon::http

@@ -62,44 +62,49 @@ DesignOutcome& find_mold(const DesignInput& input, DesignOutcome& outcome) {
 
 }  // namespace
 
-std::string design_parameters_problem(const DesignParameters& parameters) {
+std::vector<FieldProblem> design_parameter_problems(const DesignParameters& parameters) {
+  std::vector<FieldProblem> problems;
+  const auto problem = [&](const char* field, std::string message) { problems.push_back({field, std::move(message)}); };
   if (!std::isfinite(parameters.thickness_mm) || parameters.thickness_mm <= 0.0)
-    return "thickness must be a positive number of mm, got " + format_number(parameters.thickness_mm);
+    problem("thickness_mm", "thickness must be a positive number of mm, got " + format_number(parameters.thickness_mm));
   if (!std::isfinite(parameters.size_mm) || parameters.size_mm < 0.0)
-    return "size must be a positive number of mm (or 0 to keep the target's size), got " +
-           format_number(parameters.size_mm);
-  if (parameters.resolution < 0) return "resolution must be >= 0 vertices (0 never remeshes)";
-  if (parameters.resolution > 0 && parameters.resolution < 50)
-    return "resolution must be at least 50 vertices (or 0 to keep the target's), got " +
-           std::to_string(parameters.resolution);
-  if (parameters.scale && parameters.volume_ratio) return "give either a scale or a volume ratio, not both";
+    problem("size_mm", "size must be a positive number of mm (or 0 to keep the target's size), got " +
+                           format_number(parameters.size_mm));
+  if (parameters.resolution < 0)
+    problem("resolution", "resolution must be >= 0 vertices (0 never remeshes)");
+  else if (parameters.resolution > 0 && parameters.resolution < 50)
+    problem("resolution", "resolution must be at least 50 vertices (or 0 to keep the target's), got " +
+                              std::to_string(parameters.resolution));
   // A balloon inflated more than MAX_VOLUME_RATIO-fold (scale below its cube root) is no rubber's: refused
   // here rather than failing deep in the solver (a start shrunk to nothing has zero-length edges).
-  if (parameters.scale && (!std::isfinite(*parameters.scale) || *parameters.scale < std::cbrt(1.0 / MAX_VOLUME_RATIO)))
-    return "scale must be a number of at least " + format_number(std::cbrt(1.0 / MAX_VOLUME_RATIO)) + ", got " +
-           format_number(*parameters.scale);
-  if (parameters.volume_ratio &&
-      (!std::isfinite(*parameters.volume_ratio) || *parameters.volume_ratio <= 0.0 ||
-       *parameters.volume_ratio > MAX_VOLUME_RATIO))
-    return "volume ratio must be a positive number up to " + format_number(MAX_VOLUME_RATIO) + ", got " +
-           format_number(*parameters.volume_ratio);
+  if (parameters.scale && parameters.volume_ratio)
+    problem("scale", "give either a scale or a volume ratio, not both");
+  else if (parameters.scale && (!std::isfinite(*parameters.scale) || *parameters.scale < std::cbrt(1.0 / MAX_VOLUME_RATIO)))
+    problem("scale", "scale must be a number of at least " + format_number(std::cbrt(1.0 / MAX_VOLUME_RATIO)) +
+                         ", got " + format_number(*parameters.scale));
+  else if (parameters.volume_ratio &&
+           (!std::isfinite(*parameters.volume_ratio) || *parameters.volume_ratio <= 0.0 ||
+            *parameters.volume_ratio > MAX_VOLUME_RATIO))
+    problem("volume_ratio", "volume ratio must be a positive number up to " + format_number(MAX_VOLUME_RATIO) +
+                                ", got " + format_number(*parameters.volume_ratio));
   if (!parameters.method.empty()) {
     Result<DesignMethod> method = parse_design_method(parameters.method);
-    if (!method) return "method: " + method.error();
+    if (!method) problem("method", "method: " + method.error());
   }
   if (!parameters.nozzle.empty()) {
     Result<NozzleSpec> nozzle = parse_nozzle(parameters.nozzle);
-    if (!nozzle) return "nozzle: " + nozzle.error();
+    if (!nozzle) problem("nozzle", "nozzle: " + nozzle.error());
   }
   if (!std::isfinite(parameters.max_time_s) || parameters.max_time_s < 0.0)
-    return "max time must be a number of s >= 0 (0 means none), got " + format_number(parameters.max_time_s);
+    problem("max_time_s", "max time must be a number of s >= 0 (0 means none), got " + format_number(parameters.max_time_s));
   if (parameters.tolerance_samples < 0 || parameters.tolerance_samples > MAX_TOLERANCE_SAMPLES)
-    return "tolerance samples must be within 0.." + std::to_string(MAX_TOLERANCE_SAMPLES);
-  return "";
+    problem("tolerance_samples", "tolerance samples must be within 0.." + std::to_string(MAX_TOLERANCE_SAMPLES));
+  return problems;
 }
 
 Result<DesignInput> prepare_design(TriMesh target, const Material& material, const DesignParameters& parameters) {
-  if (const std::string problem = design_parameters_problem(parameters); !problem.empty()) return fail(problem);
+  if (const std::vector<FieldProblem> problems = design_parameter_problems(parameters); !problems.empty())
+    return fail(problems.front().message);
   if (const std::string problem = material_problem(material); !problem.empty()) return fail("material: " + problem);
 
   TargetPreparationOptions preparation;

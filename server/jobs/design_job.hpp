@@ -10,6 +10,7 @@
 #include "design/nozzle.hpp"
 #include "design/target_preparation.hpp"
 #include "design/thickness_tolerance.hpp"
+#include "jobs/field_problem.hpp"
 #include "jobs/simulate_job.hpp"
 #include "material/material.hpp"
 #include "mesh/tri_mesh.hpp"
@@ -39,9 +40,10 @@ struct DesignParameters {
   int tolerance_samples = 0;                   ///< thickness-tolerance samples per level; 0 skips the check
 };
 
-/// Empty when the parameters are usable, else a one-line message naming the problem (thickness, scale
-/// and volume ratio both given, non-positive values, unknown method, unparsable nozzle, ...).
-std::string design_parameters_problem(const DesignParameters& parameters);
+/// Empty when the parameters are usable, else one problem per bad field, named by its DesignJob field
+/// ("thickness_mm", "scale" when scale and volume ratio are both given, "method", "nozzle", ...), each
+/// with a one-line message (non-positive values, unknown method, unparsable nozzle, ...).
+std::vector<FieldProblem> design_parameter_problems(const DesignParameters& parameters);
 
 /// Where and how wide the mold's inflation tube is, on the rest shape.
 struct MoldParameters {

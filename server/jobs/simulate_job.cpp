@@ -17,23 +17,25 @@ std::string format_number(double value, const char* format = "%.6g") {
 
 }  // namespace
 
-std::string simulate_parameters_problem(const SimulateParameters& parameters) {
+std::vector<FieldProblem> simulate_parameter_problems(const SimulateParameters& parameters) {
+  std::vector<FieldProblem> problems;
   if (!std::isfinite(parameters.thickness_mm) || parameters.thickness_mm <= 0.0)
-    return "thickness must be a positive number of mm, got " + format_number(parameters.thickness_mm);
+    problems.push_back({"thickness_mm", "thickness must be a positive number of mm, got " + format_number(parameters.thickness_mm)});
   if (parameters.pressure_kpa && parameters.volume_ratio)
-    return "give either a pressure or a volume ratio, not both";
-  if (!parameters.pressure_kpa && !parameters.volume_ratio)
-    return "give a pressure (kPa) or a volume ratio";
-  if (parameters.pressure_kpa && (!std::isfinite(*parameters.pressure_kpa) || *parameters.pressure_kpa <= 0.0))
-    return "pressure must be a positive number of kPa, got " + format_number(*parameters.pressure_kpa);
-  if (parameters.volume_ratio && (!std::isfinite(*parameters.volume_ratio) || *parameters.volume_ratio <= 0.0))
-    return "volume ratio must be a positive number, got " + format_number(*parameters.volume_ratio);
-  return "";
+    problems.push_back({"pressure_kpa", "give either a pressure or a volume ratio, not both"});
+  else if (!parameters.pressure_kpa && !parameters.volume_ratio)
+    problems.push_back({"pressure_kpa", "give a pressure (kPa) or a volume ratio"});
+  else if (parameters.pressure_kpa && (!std::isfinite(*parameters.pressure_kpa) || *parameters.pressure_kpa <= 0.0))
+    problems.push_back({"pressure_kpa", "pressure must be a positive number of kPa, got " + format_number(*parameters.pressure_kpa)});
+  else if (parameters.volume_ratio && (!std::isfinite(*parameters.volume_ratio) || *parameters.volume_ratio <= 0.0))
+    problems.push_back({"volume_ratio", "volume ratio must be a positive number, got " + format_number(*parameters.volume_ratio)});
+  return problems;
 }
 
 Result<SimulateInput> prepare_simulate(TriMesh rest, const Material& material,
                                        const SimulateParameters& parameters) {
-  if (const std::string problem = simulate_parameters_problem(parameters); !problem.empty()) return fail(problem);
+  if (const std::vector<FieldProblem> problems = simulate_parameter_problems(parameters); !problems.empty())
+    return fail(problems.front().message);
   if (const std::string problem = material_problem(material); !problem.empty())
     return fail("material: " + problem);
 

@@ -3,7 +3,9 @@
 /// The service's simulate job kind runs simulations through this layer (and reports them: service/job_reports).
 #include <optional>
 #include <string>
+#include <vector>
 
+#include "jobs/field_problem.hpp"
 #include "material/material.hpp"
 #include "mesh/tri_mesh.hpp"
 #include "progress.hpp"
@@ -33,8 +35,9 @@ struct SimulateInput {
   double volume_ratio = 1.0;        ///< volume control target V / V_rest
 };
 
-/// Empty when the parameters are usable, else a one-line message naming the problem.
-std::string simulate_parameters_problem(const SimulateParameters& parameters);
+/// Empty when the parameters are usable, else one problem per bad field, named by its SimulateJob field
+/// ("thickness_mm", "pressure_kpa" when neither or both controls are given, "volume_ratio").
+std::vector<FieldProblem> simulate_parameter_problems(const SimulateParameters& parameters);
 
 /// Checks the parameters, the material constants and the mesh (closed, manifold, finite, ...); an
 /// inward-oriented mesh is flipped. The error names the problem (and the face or vertex).

@@ -2,6 +2,8 @@
 
 #include <mutex>
 
+#include "google/rpc/error_details.pb.h"
+#include "google/rpc/status.pb.h"
 #include "service/shard_name.hpp"
 
 namespace balloon::rpc {
@@ -101,7 +103,20 @@ grpc::Status to_grpc_status(const ServiceStatus& status) {
     case StatusCode::Cancelled: code = grpc::StatusCode::CANCELLED; break;
     case StatusCode::Internal: code = grpc::StatusCode::INTERNAL; break;
   }
-  return grpc::Status(code, status.message);
+  if (status.fields.empty()) return grpc::Status(code, status.message);
+  // The standard rich error model: a google.rpc.Status holding one google.rpc.BadRequest, serialized into
+  // the status details, so any gRPC client finds the fields without reading the message.
+  google::rpc::BadRequest bad_request;
+  for (const service::FieldViolation& field : status.fields) {
+    google::rpc::BadRequest::FieldViolation* violation = bad_request.add_field_violations();
+    violation->set_field(field.field);
+    violation->set_description(field.description);
+  }
+  google::rpc::Status details;
+  details.set_code(static_cast<int>(code));
+  details.set_message(status.message);
+  details.add_details()->PackFrom(bad_request);
+  return grpc::Status(code, status.message, details.SerializeAsString());
 }
 
 BalloonServiceImpl::BalloonServiceImpl(service::JobHandler& jobs, service::MaterialHandler& materials,

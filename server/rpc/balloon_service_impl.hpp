@@ -60,7 +60,8 @@ class BalloonServiceImpl final : public BalloonServiceBase {
   std::string m_shard_name;
 };
 
-/// A handler status as a grpc::Status (same code, same message).
+/// A handler status as a grpc::Status (same code, same message; its field violations, if any, as a
+/// google.rpc.Status holding a google.rpc.BadRequest in the error details).
 grpc::Status to_grpc_status(const service::ServiceStatus& status);
 
 }  // namespace balloon::rpc

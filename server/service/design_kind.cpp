@@ -54,7 +54,7 @@ ServiceStatus decode_design(const v1::DesignJob& job, const std::string& tenant,
   if (ServiceStatus read = read_uploaded_mesh(job.target_mesh(), "target_mesh", max_vertices, &mesh); !read.ok())
     return read;
   Result<Material> material = materials.resolve(tenant, job.material());
-  if (!material) return ServiceStatus::error(StatusCode::InvalidArgument, "material: " + material.error());
+  if (!material) return ServiceStatus::bad_field("material", "material: " + material.error());
 
   jobs::DesignParameters& parameters = decoded->parameters;
   parameters.thickness_mm = job.thickness_mm() == 0.0 ? jobs::DEFAULT_THICKNESS_MM : job.thickness_mm();
@@ -68,25 +68,25 @@ ServiceStatus decode_design(const v1::DesignJob& job, const std::string& tenant,
   parameters.max_time_s = job.max_time_s();
   parameters.tolerance_samples = job.tolerance_samples();
   if (max_vertices > 0 && parameters.resolution > max_vertices)
-    return ServiceStatus::error(StatusCode::ResourceExhausted,
-                                "resolution " + std::to_string(parameters.resolution) + " is over this server's limit of " +
-                                    std::to_string(max_vertices) + " vertices");
+    return ServiceStatus::field_error(StatusCode::ResourceExhausted, "resolution",
+                                      "resolution " + std::to_string(parameters.resolution) +
+                                          " is over this server's limit of " + std::to_string(max_vertices) + " vertices");
   if (check_mesh) {
     // What prepare_design checks before its remeshing, in the same words; the remeshing itself (seconds
     // of CGAL for a large target) runs once, on the worker.
-    if (const std::string problem = jobs::design_parameters_problem(parameters); !problem.empty())
-      return ServiceStatus::error(StatusCode::InvalidArgument, problem);
+    if (const std::vector<jobs::FieldProblem> problems = jobs::design_parameter_problems(parameters); !problems.empty())
+      return bad_fields(problems);
     if (const std::string problem = material_problem(*material); !problem.empty())
-      return ServiceStatus::error(StatusCode::InvalidArgument, "material: " + problem);
+      return ServiceStatus::bad_field("material", "material: " + problem);
     if (parameters.resolution > 0 && parameters.resolution < MIN_REMESH_RESOLUTION)
-      return ServiceStatus::error(StatusCode::InvalidArgument,
-                                  "target_mesh: resolution must be 0 (never remesh) or at least 100 vertices, got " +
-                                      std::to_string(parameters.resolution));
+      return ServiceStatus::bad_field("resolution",
+                                      "target_mesh: resolution must be 0 (never remesh) or at least 100 vertices, got " +
+                                          std::to_string(parameters.resolution));
     TriMesh checked = mesh;
     if (Result<MeshCheckReport> report = validate_balloon_mesh(checked); !report)
-      return ServiceStatus::error(StatusCode::InvalidArgument, "target_mesh: target mesh: " + report.error());
+      return ServiceStatus::bad_field("target_mesh", "target_mesh: target mesh: " + report.error());
     if (const std::string problem = nozzle_problem(std::move(checked), parameters); !problem.empty())
-      return ServiceStatus::error(StatusCode::InvalidArgument, problem);
+      return ServiceStatus::bad_field("nozzle", problem);
   }
   decoded->target = std::move(mesh);
   decoded->material = std::move(*material);
@@ -136,9 +136,9 @@ class DesignKind final : public JobKind {
 
   ServiceStatus check(const v1::JobSpec& spec, const CheckContext& context, CheckedJob* checked) const override {
     DecodedDesign decoded;
-    const ServiceStatus status = decode_design(spec.design(), context.caller.tenant, context.max_mesh_vertices, true,
-                                               context.materials, &decoded);
-    if (!status.ok()) return status;
+    ServiceStatus status = decode_design(spec.design(), context.caller.tenant, context.max_mesh_vertices, true,
+                                         context.materials, &decoded);
+    if (!status.ok()) return std::move(status).under("design.");
     checked->stored_spec = spec;
     if (names_stored_material(spec.design().material()))
       checked->stored_spec.mutable_design()->mutable_material()->set_spec(material_spec(decoded.material));

@@ -33,19 +33,24 @@ std::vector<jobs::FitDataFile> fit_files(const v1::FitMaterialJob& job) {
   return files;
 }
 
-/// Checks a fit job (data, model, the name it stores under). Errors carry their status code.
+/// Checks a fit job (data, model, the name it stores under). Errors carry their status code and the
+/// field at fault, relative to the FitMaterialJob ("data", "model", "name").
 ServiceStatus check_fit(const v1::FitMaterialJob& job, std::optional<jobs::FitInput>* input) {
-  if (job.data_size() == 0) return ServiceStatus::error(StatusCode::InvalidArgument, "fit_material.data is empty");
+  if (job.data_size() == 0) return ServiceStatus::bad_field("data", "fit_material.data is empty");
   if (!job.name().empty()) {
     const std::string problem = material_name_problem(job.name());
-    if (!problem.empty()) return ServiceStatus::error(StatusCode::InvalidArgument, "fit_material.name: " + problem);
+    if (!problem.empty()) return ServiceStatus::bad_field("name", "fit_material.name: " + problem);
     const std::vector<std::string> presets = preset_names();
     if (std::find(presets.begin(), presets.end(), job.name()) != presets.end())
-      return ServiceStatus::error(StatusCode::PermissionDenied,
-                                  "fit_material.name: '" + job.name() + "' is a preset and cannot be overwritten");
+      return ServiceStatus::field_error(StatusCode::PermissionDenied, "name",
+                                        "fit_material.name: '" + job.name() + "' is a preset and cannot be overwritten");
   }
   Result<jobs::FitInput> prepared = jobs::prepare_fit(fit_files(job), job.model());
-  if (!prepared) return ServiceStatus::error(StatusCode::InvalidArgument, "fit_material: " + prepared.error());
+  if (!prepared) {
+    // prepare_fit checks the model before the data: with a known model, the data is at fault.
+    const bool known_model = job.model() == "all" || parse_model_name(job.model());
+    return ServiceStatus::bad_field(known_model ? "data" : "model", "fit_material: " + prepared.error());
+  }
   *input = std::move(*prepared);
   return ServiceStatus::success();
 }
@@ -63,8 +68,8 @@ class FitMaterialKind final : public JobKind {
 
   ServiceStatus check(const v1::JobSpec& spec, const CheckContext&, CheckedJob* checked) const override {
     std::optional<jobs::FitInput> input;
-    const ServiceStatus status = check_fit(spec.fit_material(), &input);
-    if (!status.ok()) return status;
+    ServiceStatus status = check_fit(spec.fit_material(), &input);
+    if (!status.ok()) return std::move(status).under("fit_material.");
     checked->stored_spec = spec;
     checked->summary = fit_summary(spec.fit_material(), *input);
     return ServiceStatus::success();

@@ -164,16 +164,16 @@ ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobReques
   if (kind == nullptr)
     return ServiceStatus::error(StatusCode::InvalidArgument, "spec names no job (simulate, design or fit_material)");
   if (spec.priority() < -100 || spec.priority() > 100)
-    return ServiceStatus::error(StatusCode::InvalidArgument, "priority must be within -100..100");
+    return ServiceStatus::bad_field("priority", "priority must be within -100..100");
   if (spec.priority() > 0 && !caller.may_raise_priority)
-    return ServiceStatus::error(StatusCode::PermissionDenied,
-                                "priority above 0 is only for tenants marked 'raise-priority' in the token file");
+    return ServiceStatus::field_error(StatusCode::PermissionDenied, "priority",
+                                      "priority above 0 is only for tenants marked 'raise-priority' in the token file");
   if (!std::isfinite(spec.time_limit_s()) || spec.time_limit_s() < 0.0)
-    return ServiceStatus::error(StatusCode::InvalidArgument, "time_limit_s must be a finite number >= 0 (s)");
+    return ServiceStatus::bad_field("time_limit_s", "time_limit_s must be a finite number >= 0 (s)");
 
   const std::string& request_id = request.request_id();
   if (const std::string problem = request_id_problem(request_id); !problem.empty())
-    return ServiceStatus::error(StatusCode::InvalidArgument, problem);
+    return ServiceStatus::bad_field("request_id", problem);
   // A retry of a submission that reached the store returns the first job: nothing is parsed or stored.
   const auto first_submission = [&]() -> std::optional<store::JobRecord> {
     if (request_id.empty()) return std::nullopt;
@@ -289,14 +289,14 @@ ServiceStatus JobHandler::get(const Caller& caller, const v1::GetJobRequest& req
 ServiceStatus JobHandler::list(const Caller& caller, const v1::ListJobsRequest& request, v1::ListJobsResponse* reply) {
   int page_size = request.page_size() == 0 ? DEFAULT_PAGE_SIZE : request.page_size();
   if (page_size < 0 || page_size > MAX_PAGE_SIZE)
-    return ServiceStatus::error(StatusCode::InvalidArgument, "page_size must be within 1..1000");
+    return ServiceStatus::bad_field("page_size", "page_size must be within 1..1000");
   std::int64_t before_row = 0;
   if (!request.page_token().empty()) {
     char* end = nullptr;
     errno = 0;
     before_row = std::strtoll(request.page_token().c_str(), &end, 10);
     if (*end != '\0' || errno == ERANGE || before_row <= 0)
-      return ServiceStatus::error(StatusCode::InvalidArgument, "page_token is not one this server gave out");
+      return ServiceStatus::bad_field("page_token", "page_token is not one this server gave out");
   }
   std::optional<JobState> state;
   switch (request.state()) {
@@ -405,7 +405,7 @@ ServiceStatus JobHandler::result(const Caller& caller, const v1::GetResultReques
   const v1::MeshFormat format = request.format() == v1::MESH_FORMAT_UNSPECIFIED ? v1::MESH_FORMAT_OBJ : request.format();
   const std::string extension = mesh_format_extension(format);
   if (extension.empty() || !is_writable_mesh_format(extension))
-    return ServiceStatus::error(StatusCode::InvalidArgument, "meshes can be returned as OBJ, STL or PLY only");
+    return ServiceStatus::bad_field("format", "meshes can be returned as OBJ, STL or PLY only");
   const JobKind* kind = job_kind_named(record->kind);
   if (kind == nullptr)
     return ServiceStatus::error(StatusCode::Internal, "job " + record->job_id + " has an unknown kind");

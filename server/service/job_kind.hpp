@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "balloon/v1/balloon.pb.h"
+#include "jobs/field_problem.hpp"
 #include "mesh/tri_mesh.hpp"
 #include "progress.hpp"
 #include "service/caller.hpp"
@@ -85,10 +86,14 @@ const JobKind* job_kind_named(const std::string& name);
 
 /// Mesh format enum -> the extension core's mesh_io takes; empty for UNSPECIFIED or unknown values.
 std::string mesh_format_extension(balloon::v1::MeshFormat format);
-/// Reads an uploaded mesh (`field` names it in messages, e.g. "rest_mesh") within `max_vertices` (0: no
-/// limit): INVALID_ARGUMENT for an empty, unknown or unreadable upload, RESOURCE_EXHAUSTED over the limit.
+/// Reads an uploaded mesh (`field` names it in messages and is the error's field path, e.g. "rest_mesh")
+/// within `max_vertices` (0: no limit): INVALID_ARGUMENT for an empty, unknown or unreadable upload,
+/// RESOURCE_EXHAUSTED over the limit.
 ServiceStatus read_uploaded_mesh(const balloon::v1::MeshFile& file, const std::string& field, int max_vertices,
                                  TriMesh* mesh);
+/// INVALID_ARGUMENT with one field violation per problem (paths as the job layer names them, relative to
+/// the job message); the message is the first problem's. `problems` is not empty.
+ServiceStatus bad_fields(const std::vector<jobs::FieldProblem>& problems);
 /// "%g" of a number.
 std::string format_number(double value);
 /// True when `reference` names a tenant's stored material (not a preset, not an inline SPEC): the job

@@ -119,23 +119,28 @@ std::string mesh_format_extension(v1::MeshFormat format) {
 }
 
 ServiceStatus read_uploaded_mesh(const v1::MeshFile& file, const std::string& field, int max_vertices, TriMesh* mesh) {
-  if (file.data().empty()) return ServiceStatus::error(StatusCode::InvalidArgument, field + " is empty");
+  if (file.data().empty()) return ServiceStatus::bad_field(field, field + " is empty");
   const std::string extension = mesh_format_extension(file.format());
   if (extension.empty())
-    return ServiceStatus::error(StatusCode::InvalidArgument,
-                                field + ".format is missing or unknown (OBJ, STL, PLY, OFF, GLTF, GLB)");
+    return ServiceStatus::bad_field(field, field + ".format is missing or unknown (OBJ, STL, PLY, OFF, GLTF, GLB)");
   Result<TriMesh> read = read_mesh_from_memory(file.data(), extension, upload_limits(max_vertices));
   if (!read) {
-    return ServiceStatus::error(
-        is_over_limit_error(read.error()) ? StatusCode::ResourceExhausted : StatusCode::InvalidArgument,
+    return ServiceStatus::field_error(
+        is_over_limit_error(read.error()) ? StatusCode::ResourceExhausted : StatusCode::InvalidArgument, field,
         field + ": " + read.error());
   }
   if (max_vertices > 0 && read->vertex_count() > max_vertices)
-    return ServiceStatus::error(StatusCode::ResourceExhausted,
-                                field + " has " + std::to_string(read->vertex_count()) +
-                                    " vertices, over this server's limit of " + std::to_string(max_vertices));
+    return ServiceStatus::field_error(StatusCode::ResourceExhausted, field,
+                                      field + " has " + std::to_string(read->vertex_count()) +
+                                          " vertices, over this server's limit of " + std::to_string(max_vertices));
   *mesh = std::move(*read);
   return ServiceStatus::success();
+}
+
+ServiceStatus bad_fields(const std::vector<jobs::FieldProblem>& problems) {
+  std::vector<FieldViolation> violations;
+  for (const jobs::FieldProblem& problem : problems) violations.push_back({problem.field, problem.message});
+  return ServiceStatus::bad_fields(std::move(violations));
 }
 
 std::string format_number(double value) {

@@ -51,12 +51,12 @@ ServiceStatus MaterialHandler::put(const Caller& caller, const balloon::v1::PutM
                                    balloon::v1::Material* reply) {
   const balloon::v1::Material& material = request.material();
   if (const std::string problem = material_name_problem(material.name()); !problem.empty())
-    return ServiceStatus::error(StatusCode::InvalidArgument, problem);
+    return ServiceStatus::bad_field("material.name", problem);
   if (is_preset(material.name()))
-    return ServiceStatus::error(StatusCode::PermissionDenied,
-                                "'" + material.name() + "' is a built-in preset and cannot be replaced");
+    return ServiceStatus::field_error(StatusCode::PermissionDenied, "material.name",
+                                      "'" + material.name() + "' is a built-in preset and cannot be replaced");
   const Result<Material> parsed = parse_material_spec(material.spec());
-  if (!parsed) return ServiceStatus::error(StatusCode::InvalidArgument, "spec: " + parsed.error());
+  if (!parsed) return ServiceStatus::bad_field("material.spec", "spec: " + parsed.error());
   const store::MaterialRecord record =
       m_materials.put(caller.tenant, material.name(), material_spec(*parsed), material.description());
   fill_stored(record, reply);

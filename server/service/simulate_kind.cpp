@@ -17,18 +17,24 @@ ServiceStatus load_simulate(const v1::SimulateJob& job, const std::string& tenan
   if (ServiceStatus read = read_uploaded_mesh(job.rest_mesh(), "rest_mesh", max_vertices, &mesh); !read.ok())
     return read;
   Result<Material> material = materials.resolve(tenant, job.material());
-  if (!material) return ServiceStatus::error(StatusCode::InvalidArgument, "material: " + material.error());
+  if (!material) return ServiceStatus::bad_field("material", "material: " + material.error());
 
   jobs::SimulateParameters parameters;
   parameters.thickness_mm = job.thickness_mm() == 0.0 ? jobs::DEFAULT_THICKNESS_MM : job.thickness_mm();
   if (job.control_case() == v1::SimulateJob::kPressureKpa) parameters.pressure_kpa = job.pressure_kpa();
   if (job.control_case() == v1::SimulateJob::kVolumeRatio) parameters.volume_ratio = job.volume_ratio();
+  // The parameters and the material are checked here first, each bad field by name (prepare_simulate
+  // checks them again), so what prepare_simulate still refuses is the mesh.
+  if (const std::vector<jobs::FieldProblem> problems = jobs::simulate_parameter_problems(parameters); !problems.empty())
+    return bad_fields(problems);
+  if (const std::string problem = material_problem(*material); !problem.empty())
+    return ServiceStatus::bad_field("material", "material: " + problem);
   Result<jobs::SimulateInput> input = jobs::prepare_simulate(std::move(mesh), *material, parameters);
   if (!input) {
     // prepare_simulate prefixes mesh problems with "mesh: "; name the field the caller knows.
     std::string message = input.error();
     if (message.rfind("mesh: ", 0) == 0) message = "rest_" + message;
-    return ServiceStatus::error(StatusCode::InvalidArgument, message);
+    return ServiceStatus::bad_field("rest_mesh", message);
   }
   *loaded = std::move(*input);
   return ServiceStatus::success();
@@ -52,9 +58,9 @@ class SimulateKind final : public JobKind {
 
   ServiceStatus check(const v1::JobSpec& spec, const CheckContext& context, CheckedJob* checked) const override {
     std::optional<jobs::SimulateInput> input;
-    const ServiceStatus status =
+    ServiceStatus status =
         load_simulate(spec.simulate(), context.caller.tenant, context.max_mesh_vertices, context.materials, &input);
-    if (!status.ok()) return status;
+    if (!status.ok()) return std::move(status).under("simulate.");
     checked->stored_spec = spec;
     if (names_stored_material(spec.simulate().material()))
       checked->stored_spec.mutable_simulate()->mutable_material()->set_spec(material_spec(input->material));

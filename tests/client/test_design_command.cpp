@@ -85,6 +85,11 @@ TEST_F(DesignCommand, BadInputIsOneLineAndExitTwo) {
   expect_bad_input({"design", s, "--material", "silicone", "--max-time", "-1"}, "max time");
   expect_bad_input({"design", s, "--material", "silicone", "--tolerance-samples", "-1"}, "tolerance-samples");
   expect_bad_input({"design", s, "--material", "silicone", "--frobnicate"}, "--frobnicate");
+  // The flag is found by the field path the check names (design.thickness_mm), locally and from the
+  // service's google.rpc.BadRequest (a resolution of 60 passes the local check, the server wants 100).
+  expect_bad_input({"design", s, "--material", "silicone", "--thickness", "-0.5"}, "--thickness: ");
+  expect_bad_input({"design", s, "--material", "silicone", "--resolution", "60"}, "--resolution: ");
+  expect_bad_input({"design", s, "--material", "rubber"}, "--material: ");
 }
 
 TEST_F(DesignCommand, HelpNamesTheFilesAndTheDesignIsListed) {

@@ -20,6 +20,8 @@
 #include <grpcpp/grpcpp.h>
 
 #include "balloon/v1/balloon.grpc.pb.h"
+#include "google/rpc/error_details.pb.h"
+#include "google/rpc/status.pb.h"
 #include "http/json_mapping.hpp"
 #include "http/origin_policy.hpp"
 #include "http/static_files.hpp"
@@ -196,6 +198,32 @@ TEST(HttpGateway, StatusCodesMapAsTheContractSays) {
   for (const auto& [code, http] : table) EXPECT_EQ(http::http_status_for(code), http) << http::status_code_name(code);
   EXPECT_EQ(http::error_body(StatusCode::NOT_FOUND, "no job \"x\""),
             R"({"error":{"code":"NOT_FOUND","message":"no job \"x\""}})");
+}
+
+TEST(HttpGateway, FieldViolationsInTheStatusDetailsBecomeTheErrorFields) {
+  google::rpc::BadRequest bad_request;
+  auto* thickness = bad_request.add_field_violations();
+  thickness->set_field("design.thickness_mm");
+  thickness->set_description("thickness must be a positive number of mm, got -1");
+  auto* size = bad_request.add_field_violations();
+  size->set_field("design.size_mm");
+  size->set_description("size \"x\"");
+  google::rpc::Status details;
+  details.set_code(3);
+  details.set_message("thickness must be a positive number of mm, got -1");
+  details.add_details()->PackFrom(bad_request);
+  EXPECT_EQ(http::error_body(grpc::StatusCode::INVALID_ARGUMENT, "thickness must be a positive number of mm, got -1",
+                             details.SerializeAsString()),
+            R"({"error":{"code":"INVALID_ARGUMENT","message":"thickness must be a positive number of mm, got -1",)"
+            R"("fields":[{"field":"design.thickness_mm","description":"thickness must be a positive number of mm, got -1"},)"
+            R"({"field":"design.size_mm","description":"size \"x\""}]}})");
+  // Details that are not a google.rpc.Status, or hold no BadRequest, leave the code and message alone.
+  EXPECT_EQ(http::error_body(grpc::StatusCode::INVALID_ARGUMENT, "m", "\xff\xff not a message"),
+            R"({"error":{"code":"INVALID_ARGUMENT","message":"m"}})");
+  google::rpc::Status no_bad_request;
+  no_bad_request.add_details()->PackFrom(google::rpc::Status());
+  EXPECT_EQ(http::error_body(grpc::StatusCode::INTERNAL, "m", no_bad_request.SerializeAsString()),
+            R"({"error":{"code":"INTERNAL","message":"m"}})");
 }
 
 TEST(HttpGateway, StaticLookupRefusesTraversalAndFindsIndexFiles) {
@@ -535,6 +563,34 @@ TEST(HttpGateway, ErrorsCarryTheServiceCodeAndMessage) {
   ASSERT_EQ(direct.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_EQ(error_of(bad_mesh).first, "INVALID_ARGUMENT");
   EXPECT_EQ(error_of(bad_mesh).second, direct.error_message());
+  // ... and the field it names, by path.
+  const auto fields_of = [](const httplib::Result& response) {
+    std::vector<std::pair<std::string, std::string>> fields;
+    const auto body = parse<google::protobuf::Struct>(response->body);
+    const auto& error = body.fields().at("error").struct_value().fields();
+    if (error.count("fields") == 0) return fields;
+    for (const auto& field : error.at("fields").list_value().values())
+      fields.emplace_back(field.struct_value().fields().at("field").string_value(),
+                          field.struct_value().fields().at("description").string_value());
+    return fields;
+  };
+  ASSERT_EQ(fields_of(bad_mesh).size(), 1u) << bad_mesh->body;
+  EXPECT_EQ(fields_of(bad_mesh)[0].first, "simulate.rest_mesh");
+  EXPECT_EQ(fields_of(bad_mesh)[0].second, direct.error_message());
+  // A bad design thickness sent as the page sends it: 400 with the field "design.thickness_mm".
+  auto thickness = client->Post("/api/v1/jobs",
+                                R"({"spec":{"design":{"target_mesh":{"data":")" + base64(sphere_obj(2)) +
+                                    R"(","format":"MESH_FORMAT_OBJ"},"material":{"name":"latex"},"thickness_mm":-1}}})",
+                                "application/json");
+  ASSERT_TRUE(thickness);
+  EXPECT_EQ(thickness->status, 400);
+  ASSERT_EQ(fields_of(thickness).size(), 1u) << thickness->body;
+  EXPECT_EQ(fields_of(thickness)[0].first, "design.thickness_mm");
+  EXPECT_EQ(fields_of(thickness)[0].second, error_of(thickness).second);
+  // A failure that is no field's has no "fields".
+  auto bad_json_fields = client->Post("/api/v1/jobs", "{\"spec\": {", "application/json");
+  ASSERT_TRUE(bad_json_fields);
+  EXPECT_TRUE(fields_of(bad_json_fields).empty()) << bad_json_fields->body;
 
   for (const char* path : {"/api/v1/jobs/j-0000000000000000", "/api/v1/jobs/j-0000000000000000/events",
                            "/api/v1/jobs/j-0000000000000000/result", "/api/v1/nothing-here"}) {

@@ -12,6 +12,8 @@
 #include <set>
 #include <thread>
 
+#include "google/rpc/error_details.pb.h"
+#include "google/rpc/status.pb.h"
 #include "mesh/icosphere.hpp"
 #include "mesh/mesh_checks.hpp"
 #include "mesh/mesh_io.hpp"
@@ -199,6 +201,104 @@ TEST(Service, BadInputsGetTheRightStatusAndTheServerKeepsServing) {
   std::string job_id;
   ASSERT_TRUE(submit(*stub, simulate_request(good, 2.0), &job_id).ok());
   EXPECT_EQ(wait_for(*stub, job_id, v1::JOB_STATE_COMPLETED, 30).state(), v1::JOB_STATE_COMPLETED);
+}
+
+/// The (field, description) pairs of a failed call's google.rpc.BadRequest, read from its status details
+/// as any gRPC client reads them; empty when there are none.
+std::vector<std::pair<std::string, std::string>> field_violations(const grpc::Status& status) {
+  std::vector<std::pair<std::string, std::string>> found;
+  google::rpc::Status details;
+  if (status.error_details().empty() || !details.ParseFromString(status.error_details())) return found;
+  EXPECT_EQ(details.code(), static_cast<int>(status.error_code()));
+  EXPECT_EQ(details.message(), status.error_message());
+  for (const google::protobuf::Any& detail : details.details()) {
+    EXPECT_EQ(detail.type_url(), "type.googleapis.com/google.rpc.BadRequest");
+    google::rpc::BadRequest bad_request;
+    if (!detail.UnpackTo(&bad_request)) continue;
+    for (const auto& violation : bad_request.field_violations()) found.emplace_back(violation.field(), violation.description());
+  }
+  return found;
+}
+
+TEST(Service, BadFieldsComeAsBadRequestViolationsNamedByPath) {
+  ScratchDir scratch;
+  ServerProcess server(scratch.file("jobs.db"), {"--workers", "1"});
+  auto stub = server.stub();
+  v1::SubmitJobRequest design;
+  v1::DesignJob* job = design.mutable_spec()->mutable_design();
+  job->mutable_target_mesh()->set_data(sphere_obj(2));
+  job->mutable_target_mesh()->set_format(v1::MESH_FORMAT_OBJ);
+  job->mutable_material()->set_name("silicone");
+  job->set_thickness_mm(-0.5);
+  std::string job_id;
+
+  grpc::Status status = submit(*stub, design, &job_id);
+  ASSERT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << status.error_message();
+  auto violations = field_violations(status);
+  ASSERT_EQ(violations.size(), 1u) << status.error_message();
+  EXPECT_EQ(violations[0].first, "design.thickness_mm");
+  EXPECT_EQ(violations[0].second, status.error_message());  // the description is the human message
+
+  // Several bad fields: one violation each, in the order the checks run; the message is the first one's.
+  job->set_size_mm(-100.0);
+  job->set_max_time_s(-1.0);
+  status = submit(*stub, design, &job_id);
+  violations = field_violations(status);
+  ASSERT_EQ(violations.size(), 3u) << status.error_message();
+  EXPECT_EQ(violations[0].first, "design.thickness_mm");
+  EXPECT_EQ(violations[1].first, "design.size_mm");
+  EXPECT_EQ(violations[2].first, "design.max_time_s");
+  EXPECT_EQ(status.error_message(), violations[0].second);
+
+  // The other job fields and kinds, each by its path from the JobSpec.
+  job->set_thickness_mm(0.5);
+  job->set_size_mm(0.0);
+  job->set_max_time_s(0.0);
+  job->mutable_material()->set_name("unobtainium");
+  status = submit(*stub, design, &job_id);
+  ASSERT_EQ(field_violations(status).size(), 1u) << status.error_message();
+  EXPECT_EQ(field_violations(status)[0].first, "design.material");
+  job->mutable_material()->set_name("silicone");
+  job->mutable_target_mesh()->set_format(v1::MESH_FORMAT_UNSPECIFIED);
+  status = submit(*stub, design, &job_id);
+  ASSERT_EQ(field_violations(status).size(), 1u) << status.error_message();
+  EXPECT_EQ(field_violations(status)[0].first, "design.target_mesh");
+
+  v1::SubmitJobRequest simulate = simulate_request(sphere_obj(2), -2.0);
+  status = submit(*stub, simulate, &job_id);
+  ASSERT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  ASSERT_EQ(field_violations(status).size(), 1u) << status.error_message();
+  EXPECT_EQ(field_violations(status)[0].first, "simulate.volume_ratio");
+
+  v1::SubmitJobRequest fit;
+  fit.mutable_spec()->mutable_fit_material()->set_model("hart-smith");
+  status = submit(*stub, fit, &job_id);
+  ASSERT_EQ(field_violations(status).size(), 1u) << status.error_message();
+  EXPECT_EQ(field_violations(status)[0].first, "fit_material.data");
+
+  {
+    grpc::ClientContext context;
+    v1::PutMaterialRequest put;
+    put.mutable_material()->set_name("no spaces allowed");
+    put.mutable_material()->set_spec("neo-hookean:mu=0.3");
+    v1::Material stored;
+    status = stub->PutMaterial(&context, put, &stored);
+    ASSERT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    ASSERT_EQ(field_violations(status).size(), 1u) << status.error_message();
+    EXPECT_EQ(field_violations(status)[0].first, "material.name");
+  }
+
+  // An error that is no field's carries no details; a good request still goes through.
+  {
+    grpc::ClientContext context;
+    v1::GetJobRequest request;
+    request.set_job_id("j-0000000000000000");
+    v1::Job missing;
+    status = stub->GetJob(&context, request, &missing);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+    EXPECT_TRUE(status.error_details().empty());
+  }
+  EXPECT_TRUE(submit(*stub, simulate_request(sphere_obj(2), 2.0), &job_id).ok());
 }
 
 TEST(Service, TokensAreRequiredAndTenantsAreIsolated) {

@@ -7,8 +7,9 @@
 //
 // It loads the page, designs a balloon for the sample cube (about 400 vertices, 10 s budget), sees
 // progress events arrive and the job complete, checks that the viewer drew the shape, downloads
-// rest.obj and parses it, and checks that a bad upload (dropped on the drop zone) shows an error next
-// to the upload control.
+// rest.obj and parses it, checks that a refused thickness is shown under the thickness input and a bad
+// upload (dropped on the drop zone) next to the upload control: the server's errors are placed by the
+// field path they name (the API's error.fields), whatever their words.
 // Every request leaving loopback is aborted and recorded, and the test fails if there was any.
 // Screenshots of each step go to the artifacts folder. Exit status 0 only if every check passed.
 import { spawn } from 'node:child_process';
@@ -354,7 +355,24 @@ async function run(options) {
     check('rest.obj downloads and parses', download.suggestedFilename() === 'rest.obj' && rest.vertices > 0 && rest.faces > 0 && rest.problems.length === 0,
       `${download.suggestedFilename()}: ${rest.vertices} vertices, ${rest.faces} faces${rest.problems.length ? `; problems: ${rest.problems.slice(0, 3).join('; ')}` : ''}`);
 
-    // 7. A bad upload, dropped on the drop zone as a person would drag it there: the page says so under
+    // 7. A thickness the server refuses (the page checks only that it is a number): the server's description
+    // of the field "design.thickness_mm" appears under the thickness input, and nowhere else.
+    const refused_submission = () => page.waitForResponse(
+      (response) => response.url().endsWith('/api/v1/jobs') && response.request().method() === 'POST', { timeout: 20000 });
+    await page.fill('#thickness-input', '-1');
+    const [thickness_response] = await Promise.all([refused_submission(), page.click('#start-button')]);
+    const thickness_body = await thickness_response.json().catch(() => ({}));
+    const thickness_field = (thickness_body.error?.fields ?? []).find((field) => field.field === 'design.thickness_mm');
+    await page.waitForFunction(() => !document.getElementById('thickness-error').hidden, null, { timeout: 10000 }).catch(() => {});
+    const thickness_shown = await page.$$eval('.error:not([hidden])', (elements) => elements.map((element) => [element.id, element.textContent]));
+    check('refused thickness: its message is shown under the thickness input, found by field path',
+      thickness_response.status() === 400 && thickness_field !== undefined && thickness_shown.length === 1 &&
+        thickness_shown[0][0] === 'thickness-error' && thickness_shown[0][1] === thickness_field.description,
+      `${thickness_response.status()} ${JSON.stringify(thickness_body)}; shown: ${JSON.stringify(thickness_shown)}`);
+    await screenshot('refused-thickness');
+    await page.fill('#thickness-input', '0.5');
+
+    // 8. A bad upload, dropped on the drop zone as a person would drag it there: the page says so under
     // the upload box, and so does the server when the design starts anyway.
     await page.evaluate(() => {
       const transfer = new DataTransfer();
@@ -370,17 +388,19 @@ async function run(options) {
     const local_error = await page.$eval('#target-error', (element) => (element.hidden ? '' : element.textContent));
     check('bad upload: the page explains it under the upload box', local_error.length > 0, local_error);
     await screenshot('bad-upload');
-    await page.click('#start-button');
-    await page.waitForFunction(() => document.getElementById('target-error').textContent.includes('The server could not use this file'),
-      null, { timeout: 20000 }).catch(() => {});
+    const [upload_response] = await Promise.all([refused_submission(), page.click('#start-button')]);
+    const upload_body = await upload_response.json().catch(() => ({}));
+    const upload_field = (upload_body.error?.fields ?? []).find((field) => field.field === 'design.target_mesh');
+    await page.waitForFunction((expected) => document.getElementById('target-error').textContent === expected,
+      upload_field?.description ?? '', { timeout: 10000 }).catch(() => {});
     const server_error = await page.$eval('#target-error', (element) => (element.hidden ? '' : element.textContent));
     const next_to_upload = await page.evaluate(() => {
       const error = document.getElementById('target-error');
       return error.closest('section') === document.getElementById('file-input').closest('section');
     });
     check('bad upload: the server\'s message is shown under the upload box',
-      server_error.includes('The server could not use this file') && server_error.includes('target_mesh') && next_to_upload,
-      server_error);
+      upload_field !== undefined && server_error === upload_field.description && next_to_upload,
+      `${JSON.stringify(upload_body)}; shown: ${server_error}`);
     await screenshot('bad-upload-server-message');
 
     check('no page errors', page_errors.length === 0, page_errors.join(' | '));

@@ -2,16 +2,17 @@
 //   node --test tests/web/page_modules_test.mjs
 // Needs client/web/node_modules (three, three-mesh-bvh), which the balloon_web build installs.
 import assert from 'node:assert/strict';
+import { readFileSync } from 'node:fs';
 import { test } from 'node:test';
 import { SseParser } from '../../client/web/src/sse_parser.js';
 import { parse_obj, write_obj } from '../../client/web/src/obj_parser.js';
 import { parse_off } from '../../client/web/src/off_parser.js';
 import { nice_upper_bound, ramp_color } from '../../client/web/src/color_map.js';
-import { design_field_for_message } from '../../client/web/src/field_errors.js';
+import { error_element_for_field, show_field_errors } from '../../client/web/src/field_errors.js';
 import { mesh_format_for } from '../../client/web/src/mesh_loader.js';
 import { ordered_params, param_label } from '../../client/web/src/material_params.js';
 import { SurfaceDistance } from '../../client/web/src/surface_distance.js';
-import { base64_from_bytes, bytes_from_base64 } from '../../client/web/src/api_client.js';
+import { ApiClient, ApiError, base64_from_bytes, bytes_from_base64 } from '../../client/web/src/api_client.js';
 import { format_error_mm } from '../../client/web/src/format.js';
 
 test('SSE parser: events split across chunks, CRLF, comments and multi-line data', () => {
@@ -89,14 +90,71 @@ test('material constants come in the usual order with their units', () => {
   assert.equal(param_label('k1'), 'k1 (dimensionless)');
 });
 
-test('service messages go to the field they name', () => {
-  assert.equal(design_field_for_message("target_mesh: cannot read obj mesh data: no triangles (no 'f' lines)"), 'target');
-  assert.equal(design_field_for_message('thickness must be a positive number of mm, got -1'), 'thickness');
-  assert.equal(design_field_for_message('resolution must be at least 50 vertices (or 0 to keep the target\'s), got 3'), 'resolution');
-  assert.equal(design_field_for_message('volume ratio must be a positive number, got 0'), 'volume-ratio');
-  assert.equal(design_field_for_message('material: unknown material "rubber"'), 'material');
-  assert.equal(design_field_for_message('max time must be a number of s >= 0 (0 means none), got -3'), 'max-time');
-  assert.equal(design_field_for_message('queue is full'), null);
+/**
+ * The page's error elements as read from index.html itself (id, data-for, data-field), standing in for the
+ * DOM: what querySelectorAll('.error[data-field]') finds in the real page.
+ */
+function page_error_elements() {
+  const html = readFileSync(new URL('../../client/web/index.html', import.meta.url), 'utf8');
+  const elements = [];
+  for (const [, attributes] of html.matchAll(/<(?:p|span|div)\s([^>]*\bclass="error"[^>]*)>/g)) {
+    const attribute = (name) => attributes.match(new RegExp(`\\b${name}="([^"]*)"`))?.[1];
+    elements.push({ id: attribute('id'), dataset: { for: attribute('data-for'), field: attribute('data-field') },
+                    textContent: '', hidden: true });
+  }
+  return {
+    elements,
+    querySelectorAll: (selector) => {
+      assert.equal(selector, '.error[data-field]');
+      return elements.filter((element) => element.dataset.field !== undefined);
+    },
+    by_id: (id) => elements.find((element) => element.id === id),
+  };
+}
+
+test('a refused field is shown under its input, found by its path whatever the message says', async () => {
+  // The API's error body as the gateway sends it; the words are arbitrary, so rewording a message in the
+  // service changes nothing here. The ApiClient reads it through a stand-in fetch.
+  const body = { error: { code: 'INVALID_ARGUMENT', message: 'xyzzy 42',
+                          fields: [{ field: 'design.thickness_mm', description: 'plugh: any words at all' },
+                                   { field: 'design.nozzle', description: 'no input for this one' }] } };
+  const saved_fetch = globalThis.fetch;
+  globalThis.fetch = async () => new Response(JSON.stringify(body), { status: 400, headers: { 'Content-Type': 'application/json' } });
+  let error = null;
+  try {
+    await new ApiClient(() => '').submit_job({ design: {} });
+  } catch (thrown) {
+    error = thrown;
+  } finally {
+    globalThis.fetch = saved_fetch;
+  }
+  assert.ok(error instanceof ApiError);
+  assert.equal(error.code, 'INVALID_ARGUMENT');
+  assert.equal(error.fields.length, 2);
+
+  const page = page_error_elements();
+  const unplaced = show_field_errors(page, error.fields);
+  const thickness = page.by_id('thickness-error');
+  assert.equal(thickness.dataset.for, 'thickness-input');  // the element under the thickness input
+  assert.equal(thickness.textContent, 'plugh: any words at all');
+  assert.equal(thickness.hidden, false);
+  for (const element of page.elements.filter((e) => e !== thickness)) assert.equal(element.hidden, true, element.id);
+  // A field the page has no input for comes back, for the general message under the button.
+  assert.deepEqual(unplaced.map((violation) => violation.field), ['design.nozzle']);
+});
+
+test('every design and fit field the page sends has an error element under its input', () => {
+  const page = page_error_elements();
+  const expected = {
+    'design.target_mesh': 'drop-zone', 'design.material': 'material-select', 'design.thickness_mm': 'thickness-input',
+    'design.size_mm': 'size-input', 'design.resolution': 'resolution-input', 'design.volume_ratio': 'volume-ratio-input',
+    'design.scale': 'volume-ratio-input', 'design.max_time_s': 'max-time-input', 'design.method': 'method-select',
+    'fit_material.data': 'fit-csv', 'fit_material.data[0].csv': 'fit-csv', 'fit_material.name': 'fit-name',
+  };
+  for (const [field, input] of Object.entries(expected))
+    assert.equal(error_element_for_field(page, field)?.dataset.for, input, field);
+  assert.equal(error_element_for_field(page, 'design.thickness'), null);  // a path, not a prefix of words
+  assert.equal(error_element_for_field(page, 'priority'), null);
 });
 
 test('point-to-surface distance: exact on a scaled cube, zero on its own vertices', () => {

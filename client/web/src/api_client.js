@@ -1,19 +1,22 @@
 // The HTTP/JSON API of balloon-server (/api/v1, see notes/web-api.md): protobuf's JSON mapping with
 // proto field names, enums as strings, int64 as strings, bytes as base64. Every call sends the bearer
-// token when one is set; errors come back as ApiError with the service's code and message.
+// token when one is set; errors come back as ApiError with the service's code, message and bad fields.
 import { SseParser } from './sse_parser.js';
 
-/** An API call that failed: HTTP status, the service's status code name and its message. */
+/** An API call that failed: HTTP status, the service's status code name, its message and the bad fields. */
 export class ApiError extends Error {
   /**
    * @param {number} status  HTTP status (0 when the server could not be reached)
    * @param {string} code  status code name, e.g. "INVALID_ARGUMENT"
    * @param {string} message  the service's message, in plain words
+   * @param {{field: string, description: string}[]} [fields]  the request fields at fault, by path
+   *   ("design.thickness_mm"); empty when the service named none
    */
-  constructor(status, code, message) {
+  constructor(status, code, message, fields = []) {
     super(message);
     this.status = status;
     this.code = code;
+    this.fields = fields;
   }
 }
 
@@ -34,13 +37,15 @@ export function bytes_from_base64(text) {
   return bytes;
 }
 
-/** A response that is not 2xx -> ApiError, reading the API's `{"error":{code,message}}` body when there is one. */
+/** A response that is not 2xx -> ApiError, reading the API's `{"error":{code,message,fields}}` body when there is one. */
 async function error_from_response(response) {
   const text = await response.text().catch(() => '');
   try {
     const body = JSON.parse(text);
-    if (body && body.error && typeof body.error.message === 'string')
-      return new ApiError(response.status, body.error.code || 'UNKNOWN', body.error.message);
+    if (body && body.error && typeof body.error.message === 'string') {
+      const fields = Array.isArray(body.error.fields) ? body.error.fields.filter((f) => f && typeof f.field === 'string') : [];
+      return new ApiError(response.status, body.error.code || 'UNKNOWN', body.error.message, fields);
+    }
   } catch {
     // not JSON: fall through to the plain text
   }

@@ -1,7 +1,7 @@
 // "Fit a new material": sends a CSV of measurements as a fit_material job, waits for it, then shows
 // the fit plot (files/fit.svg) and the fitted constants, and hands the stored name to the material list.
 import { base64_from_bytes } from './api_client.js';
-import { show_error } from './field_errors.js';
+import { show_error, show_field_errors } from './field_errors.js';
 import { format_number, state_label } from './format.js';
 import { ordered_params, param_label } from './material_params.js';
 
@@ -30,11 +30,11 @@ export class FitPanel {
     this.m_elements.status.textContent = '';
   }
 
-  /** Routes a service message to the input it names. */
-  show_service_error(message) {
-    if (/^fit_material\.name\b/.test(message)) show_error(this.m_elements.name_error, message);
-    else if (/^fit_material(\.data)?\b/.test(message)) show_error(this.m_elements.csv_error, message);
-    else show_error(this.m_elements.error, message);
+  /** Shows a refused fit under the inputs its bad fields name (by path); the rest below the button. */
+  show_service_error(error) {
+    const unplaced = show_field_errors(this.m_elements.details, error.fields ?? []);
+    if (unplaced.length > 0) show_error(this.m_elements.error, unplaced.map((violation) => violation.description).join(' '));
+    else if (!(error.fields?.length > 0)) show_error(this.m_elements.error, error.message);
   }
 
   async start() {
@@ -77,7 +77,7 @@ export class FitPanel {
       this.m_on_material_stored(name);
     } catch (error) {
       elements.status.textContent = '';
-      this.show_service_error(error.message);
+      this.show_service_error(error);
     } finally {
       elements.start.disabled = false;
     }

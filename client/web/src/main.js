@@ -4,7 +4,7 @@ import { ApiClient } from './api_client.js';
 import { base64_from_bytes } from './api_client.js';
 import { DesignForm } from './design_form.js';
 import { ErrorPlot } from './error_plot.js';
-import { clear_errors, design_field_for_message, show_error } from './field_errors.js';
+import { clear_errors, show_error, show_field_errors } from './field_errors.js';
 import { FitPanel } from './fit_panel.js';
 import { JobList } from './job_list.js';
 import { JobPanel } from './job_panel.js';
@@ -175,17 +175,18 @@ async function start_design() {
   }
 }
 
-/** A refused submission: the message goes next to the input it is about. */
+/** A refused submission: each bad field's message goes under its input, found by the field's path. */
 function show_design_error(error) {
   if (error.code === 'UNAUTHENTICATED' || error.code === 'PERMISSION_DENIED') {
     show_error($('start-error'), `Not allowed: ${error.message}`);
     return;
   }
-  const field = design_field_for_message(error.message);
-  if (field === 'target') target_panel.show_error(`The server could not use this file: ${error.message}`);
-  else if (field === 'material') material_panel.show_error(error.message);
-  else if (field) design_form.show_error(field, error.message);
-  else show_error($('start-error'), `The design was not started: ${error.message}`);
+  const fields = error.fields ?? [];
+  const unplaced = show_field_errors(document, fields);
+  if (unplaced.length > 0 || fields.length === 0) {
+    const message = unplaced.length > 0 ? unplaced.map((violation) => violation.description).join(' ') : error.message;
+    show_error($('start-error'), `The design was not started: ${message}`);
+  }
 }
 
 $('start-button').addEventListener('click', start_design);
