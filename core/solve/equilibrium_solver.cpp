@@ -194,15 +194,19 @@ NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressur
     if (should_stop(settings, report)) return report;
     const Eigen::VectorXd v = m_assembly.restrict(m_model.volume_gradient(x));
 
-    // Fast path: exact Newton on the KKT system when the stiffness has the inertia of a stable
-    // volume-controlled state; globalised on the residual norm, for which it is a descent direction.
+    // Fast path: exact Newton on the KKT system; globalised on the residual norm, for which it is a
+    // descent direction. Tried at the start, after an exact step, and once the SQP steps below are
+    // full and unshifted (close to a solution), so far from one no factorization is spent on it.
     bool exact = false;
     static const bool debug = std::getenv("BALLOON_DEBUG_NEWTON") != nullptr;
     if (debug)
-      std::fprintf(stderr, "vol it %d r=%.3g tol=%.3g c=%.3g p=%.5g neg=%d skip=%d fails=%d\n", report.iterations,
-                   report.residual_norm, force_tolerance, c, pressure_mpa, m_solver.negative_pivots(), m_skip_ldlt,
-                   m_exact_fails_left);
-    if (m_exact_fails_left == 0 && factorize_exact_for_volume(x, pressure_mpa, v)) {
+      std::fprintf(stderr, "vol it %d r=%.3g tol=%.3g c=%.3g p=%.5g shift=%.3g\n", report.iterations,
+                   report.residual_norm, force_tolerance, c, pressure_mpa, m_sqp_shift);
+    const bool exact_worth_trying = report.iterations == 0 || m_last_step_exact || m_sqp_full_steps > 0;
+    m_last_step_exact = false;
+    const bool exact_factorized =
+        exact_worth_trying && m_exact_fails_left == 0 && factorize_exact_for_volume(x, pressure_mpa, v);
+    if (exact_factorized) {
       const Eigen::VectorXd a = -m_solver.solve(r);
       const Eigen::VectorXd b = m_solver.solve(v);
       const double vb = v.dot(b);
@@ -211,7 +215,10 @@ NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressur
         const Eigen::VectorXd step = m_assembly.extend(a + dp * b);
         const double merit0 = std::pow(report.residual_norm / force_tolerance, 2) + std::pow(c / volume_tolerance, 2);
         double t = 1.0;
-        for (int k = 0; k < 8 && !exact; ++k, t *= 0.5) {
+        // Towards a saddle (a symmetric state past a bifurcation, as a sphere past its pressure
+        // maximum) only a full step is taken: Newton's own convergence shows the state is near.
+        const int halvings = m_last_unstable_modes == 0 ? 8 : 1;
+        for (int k = 0; k < halvings && !exact; ++k, t *= 0.5) {
           const Eigen::VectorXd trial = x + t * step;
           if (merit(trial, pressure_mpa + t * dp, force_tolerance) <= (1.0 - 1e-4 * t) * merit0) {
             x = trial;
@@ -224,13 +231,14 @@ NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressur
     } else if (m_exact_fails_left > 0) {
       --m_exact_fails_left;
     }
-    if (exact) continue;
+    if (exact) {
+      m_last_step_exact = true;
+      continue;
+    }
 
-    // Robust path (wrinkling, local snap-through, past limit points): one step of the augmented
-    // Lagrangian L = W - p (V - Vt) + kappa/2 (V - Vt)^2 at fixed p, with a positive definite model of
-    // its Hessian (projected membrane blocks, a shift if needed, plus kappa v v^T by Sherman-Morrison),
-    // Armijo line search on L, then the multiplier update p <- p - kappa (V - Vt).
-    if (!augmented_lagrangian_step(x, pressure_mpa, target_volume, v)) {
+    // Robust path (wrinkling, snap-through, past limit points, far from a solution): an SQP step on a
+    // positive definite model of the Hessian, which descends towards a constrained minimum of W.
+    if (!sqp_step(x, pressure_mpa, target_volume, v, r, c)) {
       report.stop = NewtonStop::LineSearchFailed;
       report.message = "line search failed";
       return report;
@@ -249,6 +257,8 @@ bool EquilibriumSolver::factorize_exact_for_volume(const Eigen::VectorXd& x, dou
     --m_skip_ldlt;
     return false;
   }
+  // The simplicial LDL^T costs several supernodal LL^T: only worth it close to a solution.
+  if (m_sqp_full_steps == 0) return false;
   if (m_solver.factorize_ldlt(m_assembly.values()) != SparseSolver::Status::Ok) {
     m_skip_ldlt = 2;
     return false;
@@ -262,46 +272,69 @@ bool EquilibriumSolver::factorize_exact_for_volume(const Eigen::VectorXd& x, dou
   return true;
 }
 
-bool EquilibriumSolver::augmented_lagrangian_step(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
-                                                  const Eigen::VectorXd& v) {
-  const double c = m_model.volume(x) - target_volume;
+
+bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
+                                 const Eigen::VectorXd& v, const Eigen::VectorXd& r, double c) {
   m_model.assemble_hessian(x, pressure_mpa, m_assembly, true);
-  // Penalty: kappa |v|^2 is ten times a typical diagonal stiffness, so the volume is held firmly even
-  // where the stiffness along v is nearly zero or negative (at and past a pressure maximum).
-  const double kappa = 10.0 * m_assembly.mean_abs_diagonal() / v.squaredNorm();
-  auto lagrangian = [&](const Eigen::VectorXd& y) {
-    const double cy = m_model.volume(y) - target_volume;
-    return m_model.elastic_energy(y) - pressure_mpa * cy + 0.5 * kappa * cy * cy;
-  };
-  const Eigen::VectorXd g =
-      m_assembly.restrict(residual(x, pressure_mpa)) + kappa * c * v;  // grad_x L (free coordinates)
   const double base = std::max(1e-30, m_assembly.mean_abs_diagonal());
+  // The model H (projected membrane blocks, exact pressure term) is used unshifted when the KKT matrix
+  // [H v; v^T 0] has the inertia of a constrained minimum (H positive definite, or one negative
+  // direction that the volume constraint removes: past a pressure maximum); otherwise with the
+  // smallest Levenberg shift that makes H positive definite, kept from step to step.
+  double shift = 0.0;
   bool factorized = m_solver.factorize_llt(m_assembly.values()) == SparseSolver::Status::Ok;
-  for (double shift = 1e-4 * base; !factorized && shift < 1e8 * base; shift *= 100.0)
+  if (!factorized && m_solver.factorize_ldlt(m_assembly.values()) == SparseSolver::Status::Ok &&
+      m_solver.negative_pivots() + (v.dot(m_solver.solve(v)) > 0.0 ? 1 : 0) == 1)
+    factorized = true;
+  if (!factorized) shift = std::max(0.25 * m_sqp_shift, 1e-6 * base);
+  while (!factorized) {
+    if (shift > 1e8 * base) return false;
     factorized = m_solver.factorize_llt(m_assembly.values(), shift) == SparseSolver::Status::Ok;
-  if (!factorized) return false;
-  // (S + kappa v v^T)^-1 g by Sherman-Morrison.
-  const Eigen::VectorXd sg = m_solver.solve(g);
-  const Eigen::VectorXd sv = m_solver.solve(v);
-  const Eigen::VectorXd direction = -(sg - sv * (kappa * v.dot(sg) / (1.0 + kappa * v.dot(sv))));
-  double slope = g.dot(direction);
-  Eigen::VectorXd step = m_assembly.extend(direction);
-  if (!(slope < 0.0)) {
-    step = -m_assembly.extend(g);
-    slope = -g.squaredNorm();
+    if (!factorized) shift *= 10.0;
   }
-  const double value = lagrangian(x);
+  m_sqp_shift = shift;
+  // KKT step of the convex model: H dx - dp v = -r, v.dx = -c.
+  const Eigen::VectorXd a = m_solver.solve(r);
+  const Eigen::VectorXd b = m_solver.solve(v);
+  const double vb = v.dot(b);
+  if (!(std::abs(vb) > 0.0)) return false;
+  const double dp = (v.dot(a) - c) / vb;
+  const Eigen::VectorXd dx = -a + dp * b;
+  const double trial_pressure = pressure_mpa + dp;
+  // Merit: the augmented Lagrangian at the new multiplier; along dx its slope is -dx.H.dx - kappa c^2 < 0.
+  const double kappa = m_assembly.mean_abs_diagonal() / v.squaredNorm();
+  auto merit = [&](const Eigen::VectorXd& y) {
+    const double cy = m_model.volume(y) - target_volume;
+    return m_model.elastic_energy(y) - trial_pressure * cy + 0.5 * kappa * cy * cy;
+  };
+  const double slope = (r - dp * v + kappa * c * v).dot(dx);
+  const Eigen::VectorXd step = m_assembly.extend(dx);
+  const double value = merit(x);
+  // Close to a solution the merit's change drowns in the round-off of W; a clear fall of the KKT
+  // residual (force and volume, each against its own scale) then decides.
+  auto kkt_residual = [&](const Eigen::VectorXd& y, double p) {
+    const double force = m_assembly.restrict(residual(y, p)).norm();
+    const double volume = (m_model.volume(y) - target_volume) * std::sqrt(kappa) * std::sqrt(base);
+    const double value = std::hypot(force, volume);
+    return std::isfinite(value) ? value : std::numeric_limits<double>::infinity();
+  };
+  const double kkt0 = std::hypot(r.norm(), c * std::sqrt(kappa) * std::sqrt(base));
   double t = 1.0;
-  for (int k = 0; k < 40; ++k, t *= 0.5) {
+  for (int k = 0; k < 30; ++k, t *= 0.5) {
     const Eigen::VectorXd trial = x + t * step;
-    const double trial_value = lagrangian(trial);
-    if (std::isfinite(trial_value) && trial_value <= value + 1e-4 * t * slope) {
+    const double trial_value = merit(trial);
+    if ((std::isfinite(trial_value) && trial_value <= value + 1e-4 * t * std::min(0.0, slope)) ||
+        kkt_residual(trial, pressure_mpa + t * dp) < 0.5 * kkt0) {
       x = trial;
-      pressure_mpa -= kappa * (m_model.volume(x) - target_volume);
+      pressure_mpa = pressure_mpa + t * dp;
+      m_sqp_full_steps = shift == 0.0 ? m_sqp_full_steps + 1 : 0;
+      if (k > 2) m_sqp_shift = std::max(m_sqp_shift * 4.0, 1e-6 * base);
       return true;
     }
   }
-  return false;
+  m_sqp_shift = std::max(m_sqp_shift * 100.0, 1e-4 * base);
+  m_sqp_full_steps = 0;
+  return true;  // no progress this time; the larger shift shortens the next step
 }
 
 }  // namespace balloon

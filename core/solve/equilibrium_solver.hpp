@@ -87,9 +87,10 @@ class EquilibriumSolver {
   /// Factorizes K, or K + shift I with the smallest shift found that makes it positive definite.
   bool factorize_stiffness(const Eigen::VectorXd& x, double pressure_mpa);
 
-  /// One robust augmented-Lagrangian step for volume control (see solve_volume).
-  bool augmented_lagrangian_step(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
-                                 const Eigen::VectorXd& v);
+  /// One SQP step for volume control with a positive definite model of the Hessian (projected membrane
+  /// blocks plus a Levenberg shift), globalised on the augmented Lagrangian at the new multiplier.
+  bool sqp_step(Eigen::VectorXd& x, double& pressure_mpa, double target_volume, const Eigen::VectorXd& v,
+                const Eigen::VectorXd& r, double c);
   /// Exact stiffness for the volume-controlled KKT step, accepted when its inertia is right.
   bool factorize_exact_for_volume(const Eigen::VectorXd& x, double pressure_mpa, const Eigen::VectorXd& v);
 
@@ -99,6 +100,9 @@ class EquilibriumSolver {
   int m_skip_ldlt = 0;
   int m_exact_fails_left = 0;
   int m_last_unstable_modes = 0;
+  double m_sqp_shift = 0.0;        ///< Levenberg shift of the last SQP step (N/mm)
+  int m_sqp_full_steps = 0;        ///< consecutive unshifted full SQP steps: close enough for the exact step
+  bool m_last_step_exact = false;  ///< the last volume step was the exact one
   double m_force_floor = 0.0;  ///< N, see force_scale()
 };
 
