@@ -3,6 +3,8 @@
 /// they stood) and the global flags, and returns a process exit code (exit_codes.hpp); each prints its
 /// own help on --help.
 #include <string>
+
+#include "balloon/v1/balloon.pb.h"
 #include <vector>
 
 #include "global_options.hpp"
@@ -33,9 +35,9 @@ int run_materials_command(const std::vector<std::string>& args, const GlobalOpti
 /// `balloon fit-material DATA.csv ... --model M --test T [--radius MM --thickness MM] [--name N] [--plot F]`
 int run_fit_material_command(const std::vector<std::string>& args, const GlobalOptions& global);
 
-/// The human summary of a design report (JSON); `out_dir` empty leaves out the "written to" line.
-std::string design_summary(const std::string& report_json, const std::string& out_dir);
-/// The human summary of a simulate report (JSON).
-std::string simulate_summary(const std::string& report_json);
+/// The human summary of a design report; `out_dir` empty leaves out the "written to" line.
+std::string design_summary(const balloon::v1::DesignReport& report, const std::string& out_dir);
+/// The human summary of a simulate report.
+std::string simulate_summary(const balloon::v1::SimulateReport& report);
 
 }  // namespace balloon::cli

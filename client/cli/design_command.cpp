@@ -1,8 +1,6 @@
 /// `balloon design`: the inverse design of issue 4 as submit + watch + result through the service
 /// (embedded by default, or --server), writing rest.obj, inflated.obj, mold.stl, report.json and
 /// convergence.csv into one directory.
-#include <google/protobuf/struct.pb.h>
-#include <google/protobuf/util/json_util.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -15,6 +13,7 @@
 
 #include "cli_output.hpp"
 #include "commands.hpp"
+#include "contract/job_result_files.hpp"
 #include "design/balloon_design.hpp"
 #include "exit_codes.hpp"
 #include "jobs/design_job.hpp"
@@ -31,8 +30,6 @@ namespace balloon::cli {
 namespace {
 
 namespace v1 = balloon::v1;
-using google::protobuf::Struct;
-using google::protobuf::Value;
 
 constexpr const char* COMMAND = "design";
 
@@ -46,7 +43,7 @@ constexpr const char* HELP =
     "  rest.obj          the balloon to fabricate (mm)\n"
     "  inflated.obj      its predicted inflated shape (mm)\n"
     "  mold.stl          the rest shape with an inflation tube at the nozzle: the dip/brush mold\n"
-    "  report.json       the report (keys below)\n"
+    "  report.json       the report (see below)\n"
     "  convergence.csv   time_s,iteration,avg_error_mm,max_error_mm,residual_norm\n\n"
     "Options:\n"
     "  --material SPEC        rubber law: neo-hookean:mu=0.3 | mooney-rivlin:C1=0.18,C2=0.02 |\n"
@@ -69,14 +66,9 @@ constexpr const char* HELP =
     "                         if missing, files in it are replaced\n"
     "  --json                 print the report JSON on stdout instead of a summary\n"
     "  --help                 this text\n\n"
-    "Report keys: converged, stop_reason (matched, optimal, stalled, time_limit, iteration_limit,\n"
-    "start_failed, cancelled; converged means matched or optimal), method, avg_error_mm, max_error_mm,\n"
-    "avg_error_rel, max_error_rel (null when there is no design),\n"
-    "bbox_diag_mm, pressure_kpa, volume_ratio, iterations, time_s, vertices, active_terms,\n"
-    "baseline_avg_error_mm, baseline_max_error_mm (null when the start was not inflated), distance_energy,\n"
-    "residual_norm (N), material,\n"
-    "thickness_mm, message, resumed_from_iteration (only when it continued from a checkpoint), preparation,\n"
-    "nozzle, mold, tolerance (with --tolerance-samples), convergence.\n\n"
+    "report.json: the message balloon.v1.DesignReport of proto/balloon/v1/balloon.proto in protobuf's JSON\n"
+    "mapping (field names as in the .proto); an error never computed (no design, no baseline) is null.\n"
+    "mold.stl is built by the server (none when the report gives a mold_problem).\n\n"
     "Progress: a bar with iteration, current average error and ETA on a terminal; plain lines on stderr\n"
     "otherwise. Exit codes: 0 converged, 2 bad input (one line on stderr names it, before any work),\n"
     "3 finished without converging (the files are still written: the best design found), 5 server\n"
@@ -140,8 +132,8 @@ Result<v1::SubmitJobRequest> design_request_from_args(const ParsedArgs& args) {
 
   job->set_thickness_mm(parameters.thickness_mm);
   job->set_size_mm(parameters.size_mm);
-  // On the wire 0 means the server's default and < 0 keeps the target's mesh.
-  job->set_resolution(parameters.resolution == 0 ? -1 : parameters.resolution);
+  // Absent: the server's default; 0 keeps the target's mesh (the same meaning on the wire).
+  if (args.get("resolution")) job->set_resolution(parameters.resolution);
   if (parameters.scale) job->set_scale(*parameters.scale);
   if (parameters.volume_ratio) job->set_volume_ratio(*parameters.volume_ratio);
   job->set_method(parameters.method);
@@ -163,59 +155,43 @@ Result<v1::SubmitJobRequest> design_request_from_args(const ParsedArgs& args) {
   return request;
 }
 
-const Value* field(const Struct& object, const std::string& key) {
-  const auto it = object.fields().find(key);
-  return it == object.fields().end() ? nullptr : &it->second;
-}
-double number_field(const Struct& object, const std::string& key) {
-  const Value* value = field(object, key);
-  return value != nullptr ? value->number_value() : 0.0;
-}
-
 std::string format(const char* pattern, double value) {
   char buffer[64];
   std::snprintf(buffer, sizeof(buffer), pattern, value);
   return buffer;
 }
 
-/// A report number formatted with `pattern`, or "n/a" when the report has none (null: never computed).
-std::string shown_number(const Struct& object, const std::string& key, const char* pattern, double scale = 1.0) {
-  const Value* value = field(object, key);
-  if (value == nullptr || !value->has_number_value()) return "n/a";
-  return format(pattern, scale * value->number_value());
+/// A report number formatted with `pattern`, or "n/a" when the report has none (never computed).
+std::string shown_number(bool has, double value, const char* pattern, double scale = 1.0) {
+  return has ? format(pattern, scale * value) : "n/a";
 }
 
-std::string summary_from_report(const Struct& report, const std::string& out_dir) {
-  const Value* converged = field(report, "converged");
+std::string summary_from_report(const v1::DesignReport& report, const std::string& out_dir) {
   std::ostringstream out;
-  const Value* stop_reason = field(report, "stop_reason");
-  out << (converged != nullptr && converged->bool_value() ? "converged" : "NOT converged")
-      << (stop_reason != nullptr ? " (" + stop_reason->string_value() + ")" : std::string()) << " after "
-      << number_field(report, "iterations") << " iterations in " << format("%.3f", number_field(report, "time_s"))
-      << " s (" << (field(report, "method") ? field(report, "method")->string_value() : "") << ")\n";
-  if (const Value* message = field(report, "message"); message != nullptr && !message->string_value().empty())
-    out << "  " << message->string_value() << "\n";
-  out << "  error          avg " << shown_number(report, "avg_error_mm", "%.4g") << " mm ("
-      << shown_number(report, "avg_error_rel", "%.3g", 100.0) << "%), max "
-      << shown_number(report, "max_error_mm", "%.4g") << " mm ("
-      << shown_number(report, "max_error_rel", "%.3g", 100.0) << "%) of bbox diagonal "
-      << format("%.4g", number_field(report, "bbox_diag_mm")) << " mm\n";
-  out << "  baseline       avg " << shown_number(report, "baseline_avg_error_mm", "%.4g") << " mm, max "
-      << shown_number(report, "baseline_max_error_mm", "%.4g") << " mm (the downscaled target inflated)\n";
-  out << "  inflation      " << format("%.5g", number_field(report, "pressure_kpa")) << " kPa, volume ratio "
-      << format("%.4g", number_field(report, "volume_ratio")) << ", " << number_field(report, "vertices")
-      << " vertices\n";
-  if (const Value* tolerance = field(report, "tolerance"); tolerance != nullptr && tolerance->has_struct_value()) {
-    if (const Value* levels = field(tolerance->struct_value(), "levels"); levels != nullptr && levels->has_list_value()) {
-      out << "  tolerance     ";
-      for (const Value& level : levels->list_value().values())
-        out << " " << format("%.0f", 100.0 * number_field(level.struct_value(), "perturbation")) << "% thickness: "
-            << format("%.3g", number_field(level.struct_value(), "mean_deviation_mm")) << " mm;";
-      out << "\n";
-    }
+  out << (report.converged() ? "converged" : "NOT converged")
+      << (report.stop_reason().empty() ? std::string() : " (" + report.stop_reason() + ")") << " after "
+      << report.iterations() << " iterations in " << format("%.3f", report.time_s()) << " s (" << report.method()
+      << ")\n";
+  if (!report.message().empty()) out << "  " << report.message() << "\n";
+  out << "  error          avg " << shown_number(report.has_avg_error_mm(), report.avg_error_mm(), "%.4g") << " mm ("
+      << shown_number(report.has_avg_error_rel(), report.avg_error_rel(), "%.3g", 100.0) << "%), max "
+      << shown_number(report.has_max_error_mm(), report.max_error_mm(), "%.4g") << " mm ("
+      << shown_number(report.has_max_error_rel(), report.max_error_rel(), "%.3g", 100.0) << "%) of bbox diagonal "
+      << format("%.4g", report.bbox_diag_mm()) << " mm\n";
+  out << "  baseline       avg "
+      << shown_number(report.has_baseline_avg_error_mm(), report.baseline_avg_error_mm(), "%.4g") << " mm, max "
+      << shown_number(report.has_baseline_max_error_mm(), report.baseline_max_error_mm(), "%.4g")
+      << " mm (the downscaled target inflated)\n";
+  out << "  inflation      " << format("%.5g", report.pressure_kpa()) << " kPa, volume ratio "
+      << format("%.4g", report.volume_ratio()) << ", " << report.vertices() << " vertices\n";
+  if (report.has_tolerance() && report.tolerance().levels_size() > 0) {
+    out << "  tolerance     ";
+    for (const v1::ToleranceLevel& level : report.tolerance().levels())
+      out << " " << format("%.0f", 100.0 * level.perturbation()) << "% thickness: "
+          << format("%.3g", level.mean_deviation_mm()) << " mm;";
+    out << "\n";
   }
-  if (const Value* problem = field(report, "mold_problem"); problem != nullptr)
-    out << "  mold           not written: " << problem->string_value() << "\n";
+  if (report.has_mold_problem()) out << "  mold           not written: " << report.mold_problem() << "\n";
   out << "  written to     " << out_dir << "\n";
   return out.str();
 }
@@ -245,20 +221,18 @@ int finish_design(ServiceConnection& connection, const PreparedJob& job, const s
   Result<v1::JobResult> result = fetch_result(connection, job_id, v1::MESH_FORMAT_OBJ, &status);
   if (!result) return report_error(COMMAND, result.error(), exit_code_for(status));
   const std::string out_dir = out_dir_of(job);
-  Result<std::vector<std::string>> written = write_result_files(*result, out_dir, "obj", COMMAND);
+  Result<std::vector<std::string>> written = write_result_files(*result, out_dir);
   if (!written) return report_error(COMMAND, written.error(), EXIT_INTERNAL);
   if (global.json)
-    std::cout << result->report_json() << std::endl;
+    std::cout << contract::result_report_json(*result) << std::flush;
   else
-    std::cout << design_summary(result->report_json(), out_dir) << std::flush;
+    std::cout << design_summary(result->design_report(), out_dir) << std::flush;
   return result->converged() ? EXIT_OK : EXIT_NOT_CONVERGED;
 }
 
 }  // namespace
 
-std::string design_summary(const std::string& report_json, const std::string& out_dir) {
-  Struct report;
-  if (!google::protobuf::util::JsonStringToMessage(report_json, &report).ok()) return report_json + "\n";
+std::string design_summary(const v1::DesignReport& report, const std::string& out_dir) {
   std::string summary = summary_from_report(report, out_dir);
   if (out_dir.empty()) summary.erase(summary.rfind("  written to"));
   return summary;

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cli_output.hpp"
+#include "service/job_reports.hpp"
 #include "commands.hpp"
 #include "exit_codes.hpp"
 #include "job_command.hpp"
@@ -182,7 +183,7 @@ int finish_fit_material(ServiceConnection& connection, const PreparedJob& job, c
     if (!connection.stub().GetJob(&job_context, job_request, &finished).ok()) finished.Clear();
   }
   // The report carries every number; labels and tests come from the local input.
-  Result<jobs::FitOutcome> outcome = jobs::fit_outcome_from_json(input, result->report_json());
+  Result<jobs::FitOutcome> outcome = service::fit_outcome_from_report(input, result->fit_report());
   if (!outcome) return report_error(command, "job " + job_id + ": " + outcome.error(), EXIT_INTERNAL);
   if (finished.finished_ms() > 0 && finished.started_ms() > 0)
     outcome->time_s = 1e-3 * static_cast<double>(finished.finished_ms() - finished.started_ms());

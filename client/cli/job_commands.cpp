@@ -8,6 +8,7 @@
 
 #include "cli_output.hpp"
 #include "commands.hpp"
+#include "contract/job_result_files.hpp"
 #include "exit_codes.hpp"
 #include "job_watch.hpp"
 #include "service_connection.hpp"
@@ -50,7 +51,7 @@ constexpr const char* JOBS_HELP =
     "  delete   delete a finished job and its result (cancel a queued or running one first)\n"
     "  result   write a completed job's files into DIR, the same files its command writes:\n"
     "           design: rest.obj, inflated.obj, mold.stl, report.json, convergence.csv;\n"
-    "           simulate: rest.obj, inflated.obj, report.json; fit-material: report.json\n"
+    "           simulate: rest.obj, inflated.obj, report.json; fit-material: report.json, fit.svg\n"
     "           (--format stl|ply writes the meshes in that format instead)\n\n"
     "Exit codes: 0 ok, 2 bad input, 3 (watch/result) finished without converging, 4 no such job,\n"
     "5 unreachable, 6 not allowed, 7 no result yet, 8 the job failed or was cancelled, 130 Ctrl-C.\n\n";
@@ -93,10 +94,10 @@ int write_result(ServiceConnection& connection, const std::string& job_id, const
   if (!result) return report_error(command, result.error(), exit_code_for(status));
   if (const std::string problem = output_directory_problem(*out_dir); !problem.empty())
     return report_error(command, problem, EXIT_BAD_INPUT);
-  Result<std::vector<std::string>> written = write_result_files(*result, *out_dir, extension, command);
+  Result<std::vector<std::string>> written = write_result_files(*result, *out_dir);
   if (!written) return report_error(command, written.error(), EXIT_INTERNAL);
   if (json) {
-    std::cout << result->report_json() << std::endl;
+    std::cout << contract::result_report_json(*result) << std::flush;
   } else {
     std::cout << "wrote";
     for (std::size_t i = 0; i < written->size(); ++i) std::cout << (i == 0 ? " " : ", ") << (*written)[i];
@@ -143,8 +144,8 @@ int watch(ServiceConnection& service, const std::string& job_id, const ParsedArg
     grpc::Status status;
     Result<v1::JobResult> result = fetch_result(service, job_id, v1::MESH_FORMAT_OBJ, &status);
     if (!result) return report_error(command, result.error(), exit_code_for(status));
-    std::cout << (job.kind() == v1::JOB_KIND_DESIGN ? design_summary(result->report_json(), "")
-                                                    : simulate_summary(result->report_json()))
+    std::cout << (job.kind() == v1::JOB_KIND_DESIGN ? design_summary(result->design_report(), "")
+                                                    : simulate_summary(result->simulate_report()))
               << std::flush;
     std::fprintf(stderr, "files: %s jobs result %s --out-dir DIR\n", command_prefix(global.connection).c_str(),
                  job_id.c_str());

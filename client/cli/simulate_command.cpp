@@ -1,7 +1,5 @@
 /// `balloon simulate`: inflate a rest mesh and report the equilibrium (issue 2's CLI contract), run as
 /// a job through the service (embedded by default, or --server).
-#include <google/protobuf/struct.pb.h>
-#include <google/protobuf/util/json_util.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -10,6 +8,7 @@
 
 #include "cli_output.hpp"
 #include "commands.hpp"
+#include "contract/job_result_files.hpp"
 #include "exit_codes.hpp"
 #include "job_command.hpp"
 #include "job_watch.hpp"
@@ -40,23 +39,11 @@ constexpr const char* HELP =
     "  --out FILE          write the inflated mesh (.obj, .stl or .ply), only if the run converged\n"
     "  --json              print one JSON object on stdout instead of a summary\n"
     "  --help              this text\n\n"
-    "JSON keys: converged, pressure_kpa, volume_mm3, rest_volume_mm3, volume_ratio, mean_stretch,\n"
-    "max_stretch, newton_iterations, factorizations, load_steps, residual_norm (N), unstable_modes\n"
-    "(volume control: unstable directions of the equilibrium, 0 = stable), time_s, vertices, faces,\n"
-    "material, material_name, thickness_mm, control, flipped_orientation, message.\n\n"
+    "JSON: the message balloon.v1.SimulateReport of proto/balloon/v1/balloon.proto in protobuf's JSON\n"
+    "mapping (field names as in the .proto).\n\n"
     "Exit codes: 0 converged, 2 bad input (one line on stderr names it), 3 not converged (the result is\n"
     "still printed, no --out file), 5 server unreachable or busy, 6 not allowed, 8 the job failed,\n"
     "130 interrupted (the job keeps running), 1 internal error.\n\n";
-
-double number_field(const google::protobuf::Struct& report, const std::string& key) {
-  const auto it = report.fields().find(key);
-  return it == report.fields().end() ? 0.0 : it->second.number_value();
-}
-
-std::string string_field(const google::protobuf::Struct& report, const std::string& key) {
-  const auto it = report.fields().find(key);
-  return it == report.fields().end() ? std::string() : it->second.string_value();
-}
 
 std::string format(const char* pattern, double value) {
   char buffer[64];
@@ -64,35 +51,27 @@ std::string format(const char* pattern, double value) {
   return buffer;
 }
 
-/// The human summary, from the report JSON the service returns.
-std::string summary_from_report(const std::string& report_json) {
-  google::protobuf::Struct report;
-  if (!google::protobuf::util::JsonStringToMessage(report_json, &report).ok()) return report_json + "\n";
-  const auto flag = [&](const std::string& key) {
-    const auto it = report.fields().find(key);
-    return it != report.fields().end() && it->second.bool_value();
-  };
+/// The human summary of the service's report.
+std::string summary_from_report(const v1::SimulateReport& report) {
   std::ostringstream out;
-  out << (flag("converged") ? "converged" : "NOT converged") << " after " << number_field(report, "newton_iterations")
-      << " Newton iterations (" << number_field(report, "load_steps") << " load steps, "
-      << number_field(report, "factorizations") << " factorizations) in " << format("%.3f", number_field(report, "time_s"))
-      << " s\n";
-  if (const std::string message = string_field(report, "message"); !message.empty()) out << "  " << message << "\n";
-  if (const double unstable = number_field(report, "unstable_modes"); unstable > 0)
-    out << "  stability      a saddle under volume control: " << unstable
+  out << (report.converged() ? "converged" : "NOT converged") << " after " << report.newton_iterations()
+      << " Newton iterations (" << report.load_steps() << " load steps, " << report.factorizations()
+      << " factorizations) in " << format("%.3f", report.time_s()) << " s\n";
+  if (!report.message().empty()) out << "  " << report.message() << "\n";
+  if (report.unstable_modes() > 0)
+    out << "  stability      a saddle under volume control: " << report.unstable_modes()
         << " unstable direction(s) (wrinkling or symmetry breaking; the real balloon may take another shape)\n";
-  out << "  material       " << string_field(report, "material");
-  if (const std::string name = string_field(report, "material_name"); !name.empty()) out << " (" << name << ")";
-  out << ", thickness " << format("%.6g", number_field(report, "thickness_mm")) << " mm\n";
-  out << "  mesh           " << number_field(report, "vertices") << " vertices, " << number_field(report, "faces")
-      << " faces" << (flag("flipped_orientation") ? " (flipped to face outwards)" : "") << "\n";
-  out << "  pressure       " << format("%.6g", number_field(report, "pressure_kpa")) << " kPa\n";
-  out << "  volume         " << format("%.6g", number_field(report, "volume_mm3")) << " mm^3 (rest "
-      << format("%.6g", number_field(report, "rest_volume_mm3")) << " mm^3, ratio "
-      << format("%.6g", number_field(report, "volume_ratio")) << ")\n";
-  out << "  stretch        mean " << format("%.6g", number_field(report, "mean_stretch")) << ", max "
-      << format("%.6g", number_field(report, "max_stretch")) << "\n";
-  out << "  residual norm  " << format("%.3e", number_field(report, "residual_norm")) << " N\n";
+  out << "  material       " << report.material();
+  if (!report.material_name().empty()) out << " (" << report.material_name() << ")";
+  out << ", thickness " << format("%.6g", report.thickness_mm()) << " mm\n";
+  out << "  mesh           " << report.vertices() << " vertices, " << report.faces() << " faces"
+      << (report.flipped_orientation() ? " (flipped to face outwards)" : "") << "\n";
+  out << "  pressure       " << format("%.6g", report.pressure_kpa()) << " kPa\n";
+  out << "  volume         " << format("%.6g", report.volume_mm3()) << " mm^3 (rest "
+      << format("%.6g", report.rest_volume_mm3()) << " mm^3, ratio " << format("%.6g", report.volume_ratio()) << ")\n";
+  out << "  stretch        mean " << format("%.6g", report.mean_stretch()) << ", max "
+      << format("%.6g", report.max_stretch()) << "\n";
+  out << "  residual norm  " << format("%.3e", report.residual_norm()) << " N\n";
   return out.str();
 }
 
@@ -127,9 +106,9 @@ int finish_simulate(ServiceConnection& connection, const PreparedJob& job, const
   if (!result) return report_error(COMMAND, result.error(), exit_code_for(status));
 
   if (global.json)
-    std::cout << result->report_json() << std::endl;
+    std::cout << contract::result_report_json(*result) << std::flush;
   else
-    std::cout << summary_from_report(result->report_json()) << std::flush;
+    std::cout << summary_from_report(result->simulate_report()) << std::flush;
 
   if (!result->converged()) {
     if (out_path) std::fprintf(stderr, "balloon simulate: not converged; %s not written\n", out_path->c_str());
@@ -144,7 +123,7 @@ int finish_simulate(ServiceConnection& connection, const PreparedJob& job, const
 
 }  // namespace
 
-std::string simulate_summary(const std::string& report_json) { return summary_from_report(report_json); }
+std::string simulate_summary(const v1::SimulateReport& report) { return summary_from_report(report); }
 
 const JobCommand& simulate_job_command() {
   static const JobCommand PARTS{"simulate", HELP, {"out"}, prepare_simulate, check_simulate_outputs, finish_simulate};

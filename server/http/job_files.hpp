@@ -1,7 +1,7 @@
 #pragma once
-/// The downloadable files of a finished job (GET /api/v1/jobs/{id}/files/{file}), made from its stored
-/// result: rest.obj and inflated.obj as stored, report.json, mold.stl built from the rest mesh and the
-/// report with jobs::mold_from_report (as the CLI builds it), and fit.svg, the plot a fit report carries.
+/// The downloadable files of a finished job (GET /api/v1/jobs/{id}/files/{file}): the files
+/// contract::job_result_files makes from its result with meshes in OBJ (the same names and bytes the CLI
+/// writes): rest.obj, inflated.obj, mold.stl, report.json, convergence.csv, and fit.svg for a material fit.
 /// Kept apart from the HTTP code (httplib's <resolv.h> defines `_res`, which breaks Eigen's headers).
 #include <string>
 
@@ -11,7 +11,8 @@
 
 namespace balloon::http {
 
-/// The file names a job may have, for messages: "rest.obj, inflated.obj, mold.stl, report.json or fit.svg".
+/// The file names a job may have, for messages: "rest.obj, inflated.obj, mold.stl, report.json,
+/// convergence.csv or fit.svg".
 extern const char* const JOB_FILE_NAMES;
 
 /// True for one of JOB_FILE_NAMES.
@@ -19,7 +20,7 @@ bool is_job_file_name(const std::string& name);
 
 /// One file's bytes and media type, or why there is none.
 struct JobFile {
-  grpc::Status status;       ///< OK, or NOT_FOUND (a file this job cannot have) / INTERNAL (unreadable stored data)
+  grpc::Status status;       ///< OK, or NOT_FOUND (a file this job does not have)
   std::string bytes;         ///< the file (OK only)
   std::string content_type;  ///< its media type (OK only)
 };

@@ -5,7 +5,6 @@
 #include <cstdio>
 
 #include "design/mold.hpp"
-#include "jobs/json_reader.hpp"
 #include "jobs/json_writer.hpp"
 #include "mesh/mesh_geometry.hpp"
 
@@ -51,6 +50,7 @@ DesignOutcome& find_mold(const DesignInput& input, DesignOutcome& outcome) {
     Result<TriMesh> built = design_mold(rest, mold);
     if (built) {
       outcome.mold = mold;
+      outcome.mold_mesh = std::move(*built);
       outcome.mold_problem.clear();
       return outcome;
     }
@@ -130,35 +130,6 @@ Result<TriMesh> design_mold(const TriMesh& rest, const MoldParameters& mold) {
   return build_mold(rest, center, mold.tube_radius_mm, mold.tube_length_mm);
 }
 
-Result<TriMesh> mold_from_report(const TriMesh& rest, const std::string& report_json) {
-  Result<JsonValue> report = parse_json(report_json);
-  if (!report) return fail("the design report: " + report.error());
-  const JsonValue* mold = report->find("mold");
-  if (mold == nullptr || mold->kind != JsonValue::Kind::Object) {
-    const JsonValue* problem = report->find("mold_problem");
-    if (problem != nullptr && problem->kind == JsonValue::Kind::String && !problem->text.empty())
-      return fail("the design has no mold: " + problem->text);
-    return fail("the design report has no mold");
-  }
-  const auto number = [&](const char* key) -> Result<double> {
-    const JsonValue* value = mold->find(key);
-    if (value == nullptr || value->kind != JsonValue::Kind::Number || !std::isfinite(value->number))
-      return fail(std::string("the design report's mold has no number '") + key + "'");
-    return value->number;
-  };
-  Result<double> vertex = number("nozzle_vertex");
-  Result<double> radius = number("tube_radius_mm");
-  Result<double> length = number("tube_length_mm");
-  if (!vertex) return fail(vertex.error());
-  if (!radius) return fail(radius.error());
-  if (!length) return fail(length.error());
-  MoldParameters parameters;
-  parameters.nozzle_vertex = static_cast<int>(std::lround(*vertex));
-  parameters.tube_radius_mm = *radius;
-  parameters.tube_length_mm = *length;
-  return design_mold(rest, parameters);
-}
-
 DesignOutcome run_design(const DesignInput& input, const RunControls& controls,
                          const std::optional<DesignCheckpoint>& resume) {
   DesignOptions options;
@@ -180,7 +151,6 @@ DesignOutcome run_design(const DesignInput& input, const RunControls& controls,
   const auto cancelled = [&] { return controls.cancel != nullptr && controls.cancel->cancelled(); };
   if (cancelled()) {
     outcome.cancelled = true;
-    outcome.report_json = design_report_json(input, outcome);
     return outcome;
   }
   const bool have_design = outcome.result.rest.vertex_count() > 0 &&
@@ -214,7 +184,6 @@ DesignOutcome run_design(const DesignInput& input, const RunControls& controls,
     find_mold(input, outcome);
   else
     outcome.mold_problem = "the design produced no rest shape";
-  outcome.report_json = design_report_json(input, outcome);
   return outcome;
 }
 
@@ -225,121 +194,6 @@ std::string design_error_summary(const DesignResult& result) {
   std::snprintf(text, sizeof(text), "avg error %.3g mm (%.2g%% of %.3g mm)", *result.avg_error_mm,
                 100.0 * *result.avg_error_rel, result.bbox_diag_mm);
   return text;
-}
-
-std::string design_report_json(const DesignInput& input, const DesignOutcome& outcome) {
-  const DesignResult& result = outcome.result;
-  const PreparedTarget& target = input.target;
-  JsonWriter json;
-  json.begin_object()
-      .value("converged", result.converged)
-      .value("stop_reason", design_stop_name(result.stop))
-      .value("method", design_method_name(result.method))
-      .value("avg_error_mm", result.avg_error_mm)
-      .value("max_error_mm", result.max_error_mm)
-      .value("avg_error_rel", result.avg_error_rel)
-      .value("max_error_rel", result.max_error_rel)
-      .value("bbox_diag_mm", result.bbox_diag_mm)
-      .value("pressure_kpa", result.pressure_kpa)
-      .value("volume_ratio", result.volume_ratio)
-      .value("iterations", result.iterations)
-      .value("time_s", result.time_s)
-      .value("vertices", result.rest.vertex_count())
-      .value("faces", result.rest.face_count());
-  json.begin_array("active_terms");
-  for (const std::string& term : result.active_terms) json.value("", term);
-  json.end_array();
-  // Ratios of values that exist; null otherwise (no baseline, no design, or a design with zero error).
-  const auto ratio = [](const std::optional<double>& a, const std::optional<double>& b) -> std::optional<double> {
-    if (!a || !b || !(*b > 0.0)) return std::nullopt;
-    return *a / *b;
-  };
-  json.value("baseline_avg_error_mm", result.baseline_avg_error_mm)
-      .value("baseline_max_error_mm", result.baseline_max_error_mm)
-      .value("baseline_avg_error_rel", ratio(result.baseline_avg_error_mm, result.bbox_diag_mm))
-      .value("improvement_over_baseline", ratio(result.baseline_avg_error_mm, result.avg_error_mm))
-      .value("distance_energy", result.distance_energy)
-      .value("residual_norm", result.residual_norm)
-      .value("material", material_spec(input.material))
-      .value("material_name", input.material.name)
-      .value("thickness_mm", input.parameters.thickness_mm)
-      .value("start_scale", input.start_scale)
-      .value("max_time_s", input.parameters.max_time_s)
-      .value("cancelled", outcome.cancelled)
-      .value("message", result.message);
-  if (result.resumed_from_iteration) json.value("resumed_from_iteration", *result.resumed_from_iteration);
-
-  json.begin_object("preparation")
-      .value("summary", target.summary)
-      .value("scale_factor", target.scale_factor)
-      .value("reoriented", target.reoriented)
-      .value("unreferenced_vertices_removed", target.unreferenced_vertices_removed)
-      .value("remeshed", target.remeshed)
-      .value("vertices_before", target.vertices_before)
-      .value("vertices_after", target.vertices_after)
-      .value("faces_before", target.faces_before)
-      .value("faces_after", target.faces_after)
-      .value("min_angle_before_deg", target.min_angle_before_deg)
-      .value("min_angle_after_deg", target.min_angle_after_deg)
-      .value("target_edge_length_mm", target.target_edge_length_mm)
-      .value("bbox_diag_mm", target.bbox_diag_mm)
-      .value("volume_mm3", target.volume_mm3)
-      .value("self_intersecting", target.self_intersecting)
-      .end_object();
-
-  json.begin_object("nozzle").value("requested", input.parameters.nozzle);
-  if (input.nozzle) {
-    json.value("center_vertex", input.nozzle->center_vertex)
-        .value("radius_mm", input.nozzle->radius_mm)
-        .value("fixed_vertices", static_cast<int>(input.nozzle->vertices.size()));
-  } else {
-    json.value("fixed_vertices", 0);
-  }
-  json.end_object();
-
-  if (outcome.mold) {
-    json.begin_object("mold")
-        .value("nozzle_vertex", outcome.mold->nozzle_vertex)
-        .value("tube_radius_mm", outcome.mold->tube_radius_mm)
-        .value("tube_length_mm", outcome.mold->tube_length_mm)
-        .end_object();
-  } else {
-    json.value("mold_problem", outcome.mold_problem);
-  }
-
-  if (outcome.tolerance) {
-    json.begin_object("tolerance")
-        .value("samples", input.parameters.tolerance_samples)
-        .value("seed", static_cast<long long>(TOLERANCE_SEED))
-        .value("control", "volume_ratio");
-    json.begin_array("levels");
-    for (const ThicknessToleranceLevel& level : outcome.tolerance->levels) {
-      json.begin_object()
-          .value("perturbation", level.perturbation)
-          .value("mean_deviation_mm", level.mean_deviation_mm)
-          .value("max_deviation_mm", level.max_deviation_mm)
-          .value("samples", level.samples)
-          .value("failed_samples", level.failed_samples)
-          .end_object();
-    }
-    json.end_array().end_object();
-  }
-
-  // Parallel arrays keep the log compact; convergence_csv() writes the same numbers as CSV.
-  json.begin_object("convergence");
-  const auto column = [&](const char* key, auto field) {
-    json.begin_array(key);
-    for (const ConvergenceSample& sample : result.log) json.value("", field(sample));
-    json.end_array();
-  };
-  column("time_s", [](const ConvergenceSample& s) { return s.time_s; });
-  column("iteration", [](const ConvergenceSample& s) { return s.iteration; });
-  column("avg_error_mm", [](const ConvergenceSample& s) { return s.avg_error_mm; });
-  column("max_error_mm", [](const ConvergenceSample& s) { return s.max_error_mm; });
-  column("residual_norm", [](const ConvergenceSample& s) { return s.residual_norm; });
-  json.end_object();
-  json.end_object();
-  return json.str();
 }
 
 std::string convergence_csv(const std::vector<ConvergenceSample>& log) {

@@ -1,7 +1,7 @@
 #pragma once
 /// The design job without any transport: check the request, prepare the target, run the inverse design,
-/// and describe the outcome (report JSON, convergence log, mold). The CLI and the gRPC service both go
-/// through this layer, so their checks, reports and molds agree.
+/// and find the mold. The service's design job kind runs designs through this layer and reports them
+/// (service/job_reports); the CLI checks requests with design_parameters_problem.
 #include <optional>
 #include <string>
 #include <vector>
@@ -70,39 +70,24 @@ struct DesignOutcome {
   DesignResult result;
   std::optional<ThicknessTolerance> tolerance;  ///< when tolerance samples were asked and the run finished
   std::optional<MoldParameters> mold;           ///< the tube that builds a valid mold, if one was found
+  std::optional<TriMesh> mold_mesh;             ///< the mold built with that tube (mm): what mold.stl holds
   std::string mold_problem;                     ///< why no mold could be built (empty when one was)
-  std::string report_json;                      ///< see design_report_json
   bool cancelled = false;                       ///< the cancel token fired before the run finished
 };
 
 /// Runs the design (progress phases "design", then "tolerance"; the cancel token is checked between
-/// iterations), the tolerance check if asked, and finds the mold tube. controls.max_time_s, when set,
-/// caps the optimizer's budget. Never throws for non-convergence: that is `result.converged == false`.
+/// iterations), the tolerance check if asked, and builds the mold (the server stores it with the result).
+/// controls.max_time_s, when set, caps the optimizer's budget. Never throws for non-convergence: that is `result.converged == false`.
 /// `resume`: the design's last checkpoint when it runs again after an interruption (see DesignOptions).
 DesignOutcome run_design(const DesignInput& input, const RunControls& controls,
                          const std::optional<DesignCheckpoint>& resume = std::nullopt);
 
-/// The mold for a rest shape (see build_mold): the service stores only meshes and the report, so the
-/// client builds mold.stl from the rest mesh and the report's "mold" object through this same function.
+/// The mold for a rest shape (see build_mold) with the tube `mold`.
 Result<TriMesh> design_mold(const TriMesh& rest, const MoldParameters& mold);
-
-/// mold.stl's mesh from a finished design as the store keeps it: `rest` is the job's rest mesh (mm) and
-/// `report_json` its report (design_report_json), whose "mold" object names the tube. The one function
-/// the CLI and the HTTP gateway both build the mold with. Fails when the report has no mold (the message
-/// then carries the report's mold_problem), is not a design report, or the tube cannot be built.
-Result<TriMesh> mold_from_report(const TriMesh& rest, const std::string& report_json);
 
 /// "avg error 0.12 mm (0.1% of 120 mm)", or "no design error (stop reason start_failed)" when there
 /// is none: for logs and the COMPLETED event's message.
 std::string design_error_summary(const DesignResult& result);
-
-/// One JSON object. Issue 4's keys: converged, method, avg_error_mm, max_error_mm, avg_error_rel,
-/// max_error_rel, bbox_diag_mm, pressure_kpa, volume_ratio, iterations, time_s, vertices, active_terms,
-/// baseline_avg_error_mm, baseline_max_error_mm; also faces, material, material_name, thickness_mm,
-/// distance_energy, residual_norm (N), message, preparation {...}, nozzle {...}, mold {nozzle_vertex,
-/// tube_radius_mm, tube_length_mm} or mold_problem, tolerance {...} when asked, and convergence
-/// {time_s, iteration, avg_error_mm, max_error_mm, residual_norm} as parallel arrays.
-std::string design_report_json(const DesignInput& input, const DesignOutcome& outcome);
 
 /// The convergence log as CSV: header `time_s,iteration,avg_error_mm,max_error_mm,residual_norm`,
 /// one row per sample.

@@ -13,7 +13,6 @@
 #include <memory>
 #include <sstream>
 
-#include "jobs/json_reader.hpp"
 #include "jobs/json_writer.hpp"
 #include "calibration/bulge_simulation.hpp"
 #include "calibration/fem_bulge_fit.hpp"
@@ -151,113 +150,6 @@ int best_fit_index(const FitOutcome& outcome) {
     if (outcome.fits[i].rms_relative_residual < outcome.fits[static_cast<size_t>(best)].rms_relative_residual)
       best = static_cast<int>(i);
   return best;
-}
-
-namespace {
-
-/// A number member; null (how JsonWriter writes non-finite numbers) reads as infinity.
-Result<double> number_member(const JsonValue& object, const std::string& key) {
-  const JsonValue* value = object.find(key);
-  if (value == nullptr) return fail("the fit report lacks '" + key + "'");
-  if (value->kind == JsonValue::Kind::Null) return std::numeric_limits<double>::infinity();
-  if (value->kind != JsonValue::Kind::Number) return fail("the fit report's '" + key + "' is not a number");
-  return value->number;
-}
-
-bool bool_member(const JsonValue& object, const std::string& key) {
-  const JsonValue* value = object.find(key);
-  return value != nullptr && value->kind == JsonValue::Kind::Bool && value->boolean;
-}
-
-std::string string_member(const JsonValue& object, const std::string& key) {
-  const JsonValue* value = object.find(key);
-  return value != nullptr && value->kind == JsonValue::Kind::String ? value->text : std::string();
-}
-
-Result<FitResult> fit_from_json(const JsonValue& object, MaterialModel model, const FitInput& input) {
-  if (object.kind != JsonValue::Kind::Object) return fail("the fit report holds a non-object fit");
-  if (string_member(object, "model") != model_name(model))
-    return fail("the fit report's model '" + string_member(object, "model") + "' is not the " + model_name(model) +
-                " fit asked for");
-  FitResult fit;
-  fit.material.model = model;
-  const std::vector<std::string> names = parameter_names(model);
-  const JsonValue* params = object.find("params");
-  const JsonValue* std_errors = object.find("std_errors");
-  if (params == nullptr || params->kind != JsonValue::Kind::Object) return fail("the fit report lacks 'params'");
-  for (size_t i = 0; i < names.size() && i < fit.material.params.size(); ++i) {
-    Result<double> value = number_member(*params, names[i]);
-    if (!value) return fail(value.error());
-    fit.material.params[i] = *value;
-    if (std_errors != nullptr && std_errors->find(names[i]) != nullptr) {
-      Result<double> error = number_member(*std_errors, names[i]);
-      if (!error) return fail(error.error());
-      fit.std_errors.push_back(*error);
-    }
-  }
-  for (auto [key, target] : {std::pair<const char*, double*>{"rms_residual", &fit.rms_residual},
-                             {"max_residual", &fit.max_residual},
-                             {"rms_relative_residual", &fit.rms_relative_residual},
-                             {"max_relative_residual", &fit.max_relative_residual}}) {
-    Result<double> value = number_member(object, key);
-    if (!value) return fail(value.error());
-    *target = *value;
-  }
-  Result<double> points = number_member(object, "points");
-  if (!points) return fail(points.error());
-  fit.points = static_cast<int>(*points);
-  fit.residual_unit = string_member(object, "residual_unit");
-  fit.converged = bool_member(object, "converged");
-  fit.message = string_member(object, "message");
-  if (const JsonValue* regimes = object.find("regimes")) {
-    fit.data_inflection = bool_member(*regimes, "data_inflection");
-    fit.data_stiffening = bool_member(*regimes, "data_stiffening");
-    fit.model_inflection = bool_member(*regimes, "model_inflection");
-    fit.model_stiffening = bool_member(*regimes, "model_stiffening");
-  }
-  const JsonValue* sets = object.find("sets");
-  if (sets == nullptr || sets->kind != JsonValue::Kind::Array || sets->items.size() != input.sets.size())
-    return fail("the fit report's sets do not match the data sent");
-  for (size_t s = 0; s < input.sets.size(); ++s) {
-    const JsonValue& item = sets->items[s];
-    SetFit set;
-    // Labels and tests come from the local input: the service sees no file names.
-    set.label = input.sets[s].label;
-    set.kind = input.sets[s].kind;
-    Result<double> set_points = number_member(item, "points");
-    Result<double> rms = number_member(item, "rms_residual");
-    Result<double> max = number_member(item, "max_residual");
-    if (!set_points || !rms || !max) return fail("the fit report's sets lack points or residuals");
-    set.points = static_cast<int>(*set_points);
-    set.rms_residual = *rms;
-    set.max_residual = *max;
-    set.residual_unit = string_member(item, "residual_unit");
-    fit.sets.push_back(std::move(set));
-  }
-  return fit;
-}
-
-}  // namespace
-
-Result<FitOutcome> fit_outcome_from_json(const FitInput& input, const std::string& report_json) {
-  Result<JsonValue> document = parse_json(report_json);
-  if (!document) return fail("the fit report: " + document.error());
-  std::vector<const JsonValue*> objects;
-  if (document->kind == JsonValue::Kind::Array) {
-    for (const JsonValue& item : document->items) objects.push_back(&item);
-  } else {
-    objects.push_back(&*document);
-  }
-  if (objects.size() != input.models.size())
-    return fail("the fit report has " + std::to_string(objects.size()) + " fit(s), " +
-                std::to_string(input.models.size()) + " were asked for");
-  FitOutcome outcome;
-  for (size_t m = 0; m < objects.size(); ++m) {
-    Result<FitResult> fit = fit_from_json(*objects[m], input.models[m], input);
-    if (!fit) return fail(fit.error());
-    outcome.fits.push_back(std::move(*fit));
-  }
-  return outcome;
 }
 
 namespace {

@@ -2,7 +2,7 @@
 /// The material-fit job without any transport: parse and check measurement files, fit one or all rubber
 /// laws, and describe the outcome (text, JSON, SVG plot, provenance for the material library).
 /// The service's fit_material job runs fits through this layer; the CLI checks data with prepare_fit and
-/// reads the job's report back with fit_outcome_from_json to print and plot it.
+/// reads the job's typed report back (service/job_reports: fit_outcome_from_report) to print and plot it.
 #include <string>
 #include <string_view>
 #include <vector>
@@ -50,17 +50,11 @@ Result<FitOutcome> run_fit(const FitInput& input, const CancelToken* cancel = nu
 /// Index into outcome.fits of the best fit (smallest RMS relative residual).
 int best_fit_index(const FitOutcome& outcome);
 
-/// Reads a report written by fit_report_json back into fits, for a client that ran the fit as a service
-/// job: `input` is the same job's input (checked locally), which gives each fit its model and each set
-/// its label and test. Null numbers (non-finite standard errors) read back as infinity. Fails on a
-/// report that does not match the input.
-Result<FitOutcome> fit_outcome_from_json(const FitInput& input, const std::string& report_json);
-
 /// One fit as a JSON object: model, spec, params (by SPEC name), std_errors, rms_residual, max_residual,
 /// residual_unit, rms_relative_residual, max_relative_residual, points, converged, regimes, sets, message.
 std::string fit_json(const FitResult& fit);
-/// The whole report: one object for a single model, a list of objects for "all". The (first) object
-/// also carries `plot_svg`, the fit_plot_svg of the whole outcome, for clients without the data.
+/// What `balloon fit-material --json` prints: one object for a single model, a list of objects for "all".
+/// The (first) object also carries `plot_svg`, the fit_plot_svg of the whole outcome.
 std::string fit_report_json(const FitInput& input, const FitOutcome& outcome);
 /// A few human-readable lines per model, with units.
 std::string fit_summary_text(const FitInput& input, const FitOutcome& outcome);

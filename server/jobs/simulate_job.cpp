@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <sstream>
 
-#include "jobs/json_writer.hpp"
 #include "mesh/mesh_checks.hpp"
 
 namespace balloon::jobs {
@@ -70,40 +69,7 @@ SimulateOutcome run_simulate(const SimulateInput& input, const RunControls& cont
   SimulateOutcome outcome;
   outcome.result = inflate(input.rest, options);
   outcome.cancelled = controls.cancel != nullptr && controls.cancel->cancelled() && !outcome.result.converged;
-  outcome.report_json = simulate_report_json(input, outcome.result);
   return outcome;
-}
-
-std::string simulate_report_json(const SimulateInput& input, const InflationResult& result) {
-  JsonWriter json;
-  json.begin_object()
-      .value("converged", result.converged)
-      .value("pressure_kpa", result.pressure_kpa)
-      .value("volume_mm3", result.volume_mm3)
-      .value("rest_volume_mm3", result.rest_volume_mm3)
-      .value("volume_ratio", result.volume_ratio)
-      .value("mean_stretch", result.mean_stretch)
-      .value("max_stretch", result.max_stretch)
-      .value("newton_iterations", result.newton_iterations)
-      .value("factorizations", result.factorizations)
-      .value("load_steps", result.load_steps)
-      .value("residual_norm", result.residual_norm)
-      .value("unstable_modes", result.unstable_modes)
-      .value("time_s", result.time_s)
-      .value("vertices", input.rest.vertex_count())
-      .value("faces", input.rest.face_count())
-      .value("material", material_spec(input.material))
-      .value("material_name", input.material.name)
-      .value("thickness_mm", input.thickness_mm)
-      .value("control", input.control == InflationControl::Pressure ? "pressure" : "volume_ratio");
-  if (input.control == InflationControl::Pressure)
-    json.value("target_pressure_kpa", input.pressure_kpa);
-  else
-    json.value("target_volume_ratio", input.volume_ratio);
-  json.value("flipped_orientation", input.flipped_orientation)
-      .value("message", result.message)
-      .end_object();
-  return json.str();
 }
 
 }  // namespace balloon::jobs

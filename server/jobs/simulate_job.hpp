@@ -1,6 +1,6 @@
 #pragma once
 /// The simulate job without any transport: check the request, inflate, and describe the outcome.
-/// The CLI and the gRPC service both run simulations through this layer, so their reports agree.
+/// The service's simulate job kind runs simulations through this layer (and reports them: service/job_reports).
 #include <optional>
 #include <string>
 
@@ -48,19 +48,13 @@ struct RunControls {
   double max_time_s = 0.0;              ///< wall-time budget (s); 0 means none
 };
 
-/// The finished run and its report.
+/// The finished run (the service reports it: service/job_reports).
 struct SimulateOutcome {
   InflationResult result;   ///< equilibrium (or the last iterate when not converged)
-  std::string report_json;  ///< see simulate_report_json
   bool cancelled = false;   ///< the cancel token fired before the run finished
 };
 
 /// Inflates a prepared job. Never throws for non-convergence: that is `result.converged == false`.
 SimulateOutcome run_simulate(const SimulateInput& input, const RunControls& controls);
-
-/// One JSON object: converged, pressure_kpa, volume_mm3, rest_volume_mm3, volume_ratio, mean_stretch,
-/// max_stretch, newton_iterations, factorizations, load_steps, residual_norm (N), unstable_modes, time_s,
-/// vertices, faces, material (SPEC), material_name, thickness_mm, control, flipped_orientation, message.
-std::string simulate_report_json(const SimulateInput& input, const InflationResult& result);
 
 }  // namespace balloon::jobs

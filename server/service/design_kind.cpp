@@ -1,5 +1,5 @@
-// The design job kind: the inverse design of a target (jobs/design_job), storing the rest and inflated
-// meshes and the report.
+// The design job kind: the inverse design of a target (jobs/design_job), storing the rest, inflated and
+// mold meshes and the report.
 #include <algorithm>
 #include <cstdio>
 
@@ -8,6 +8,7 @@
 #include "mesh/mesh_geometry.hpp"
 #include "mesh/mesh_io.hpp"
 #include "service/job_kind.hpp"
+#include "service/job_reports.hpp"
 #include "store/mesh_blob.hpp"
 
 namespace balloon::service {
@@ -58,8 +59,8 @@ ServiceStatus decode_design(const v1::DesignJob& job, const std::string& tenant,
   jobs::DesignParameters& parameters = decoded->parameters;
   parameters.thickness_mm = job.thickness_mm() == 0.0 ? jobs::DEFAULT_THICKNESS_MM : job.thickness_mm();
   parameters.size_mm = job.size_mm();
-  // On the wire 0 means the default and < 0 "never remesh" (proto3 has no unset ints); here 0 never remeshes.
-  parameters.resolution = job.resolution() == 0 ? jobs::DEFAULT_DESIGN_RESOLUTION : std::max(0, job.resolution());
+  // Absent: the default remesh target; 0 keeps the target's mesh, on the wire as in jobs::DesignParameters.
+  parameters.resolution = job.has_resolution() ? job.resolution() : jobs::DEFAULT_DESIGN_RESOLUTION;
   if (job.inflation_case() == v1::DesignJob::kScale) parameters.scale = job.scale();
   if (job.inflation_case() == v1::DesignJob::kVolumeRatio) parameters.volume_ratio = job.volume_ratio();
   parameters.method = job.method();
@@ -166,7 +167,8 @@ class DesignKind final : public JobKind {
     result.converged = outcome.result.converged;
     result.rest_mesh = store::encode_mesh_blob(outcome.result.rest);
     result.inflated_mesh = store::encode_mesh_blob(TriMesh{outcome.result.inflated, outcome.result.rest.faces});
-    result.report_json = outcome.report_json;
+    result.report = design_report(input, outcome).SerializeAsString();
+    if (outcome.mold_mesh) result.mold_mesh = store::encode_mesh_blob(*outcome.mold_mesh);
     const std::string errors = jobs::design_error_summary(outcome.result);
     std::string message = (outcome.result.converged ? "completed: converged in " : "completed without converging in ") +
                           format_number(outcome.result.time_s) + " s, " + errors +

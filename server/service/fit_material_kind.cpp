@@ -4,6 +4,7 @@
 
 #include "jobs/fit_job.hpp"
 #include "service/job_kind.hpp"
+#include "service/job_reports.hpp"
 
 namespace balloon::service {
 namespace {
@@ -94,7 +95,7 @@ class FitMaterialKind final : public JobKind {
     store::ResultRecord result;
     result.converged = true;
     for (const FitResult& fit : outcome->fits) result.converged = result.converged && fit.converged;
-    result.report_json = jobs::fit_report_json(*input, *outcome);
+    result.report = fit_report(*input, *outcome).SerializeAsString();
     std::string message = "completed: best fit " + material_spec(best.material) + " in " +
                           format_number(outcome->time_s) + " s" + stored_note;
     return RunOutcome::completed(std::move(result), std::move(message));
@@ -104,8 +105,7 @@ class FitMaterialKind final : public JobKind {
   ServiceStatus fill_result(const store::ResultRecord& stored, v1::MeshFormat, v1::JobResult* reply) const override {
     reply->set_kind(proto_kind());
     reply->set_converged(stored.converged);
-    reply->set_report_json(stored.report_json);
-    return ServiceStatus::success();
+    return fill_report(stored, reply);
   }
 };
 

@@ -70,9 +70,12 @@ class JobKind {
                               CheckedJob* checked) const = 0;
   /// Runs the job to an outcome. May throw: the handler records any exception as a failure.
   virtual RunOutcome run(RunContext& context) const = 0;
-  /// Fills `reply` from a stored result; meshes in `format` (checked writable by the caller).
+  /// Fills `reply` from a stored result; meshes in `format` (checked writable by the caller), a design's
+  /// mold in STL, and the typed report (fill_report).
   virtual ServiceStatus fill_result(const store::ResultRecord& stored, balloon::v1::MeshFormat format,
                                     balloon::v1::JobResult* reply) const;
+  /// Sets the kind's report in `reply` from the stored one.
+  ServiceStatus fill_report(const store::ResultRecord& stored, balloon::v1::JobResult* reply) const;
 };
 
 /// The kind a spec asks for; null when it names none.

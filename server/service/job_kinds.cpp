@@ -1,7 +1,10 @@
-// The list of job kinds and what they share (mesh results, format names).
+// The list of job kinds and what they share (mesh results, reports, format names).
+#include <google/protobuf/util/json_util.h>
+
 #include <algorithm>
 #include <cstdio>
 
+#include "jobs/design_job.hpp"
 #include "mesh/mesh_io.hpp"
 #include "service/job_kind.hpp"
 #include "store/mesh_blob.hpp"
@@ -9,6 +12,50 @@
 namespace balloon::service {
 
 namespace v1 = balloon::v1;
+
+namespace {
+
+/// The kind's report message inside `reply`, selected in the `report` oneof.
+google::protobuf::Message* report_of(v1::JobKind kind, v1::JobResult* reply) {
+  switch (kind) {
+    case v1::JOB_KIND_SIMULATE: return reply->mutable_simulate_report();
+    case v1::JOB_KIND_DESIGN: return reply->mutable_design_report();
+    case v1::JOB_KIND_FIT_MATERIAL: return reply->mutable_fit_report();
+    default: return nullptr;
+  }
+}
+
+/// A report stored as JSON before reports were typed (schema version < 4), read into its message. A fit
+/// report was one object, or a list for "all"; unknown keys (e.g. the fit's plot_svg) are skipped.
+bool read_legacy_report(v1::JobKind kind, std::string json, google::protobuf::Message* report) {
+  if (kind == v1::JOB_KIND_FIT_MATERIAL) {
+    const std::size_t start = json.find_first_not_of(" \t\r\n");
+    json = start != std::string::npos && json[start] == '[' ? "{\"fits\":" + json + "}" : "{\"fits\":[" + json + "]}";
+  }
+  google::protobuf::util::JsonParseOptions options;
+  options.ignore_unknown_fields = true;
+  return google::protobuf::util::JsonStringToMessage(json, report, options).ok();
+}
+
+/// A design's mold as binary STL: the stored one, or, for a design stored before the server kept molds,
+/// built from the rest shape with the report's tube. Empty when the design has no mold.
+Result<std::string> mold_stl(const store::ResultRecord& stored, const TriMesh& rest, const v1::DesignReport& report) {
+  if (!stored.mold_mesh.empty()) {
+    Result<TriMesh> mold = store::decode_mesh_blob(stored.mold_mesh);
+    if (!mold) return fail("the stored mold is unreadable");
+    return write_mesh_to_memory(*mold, "stl");
+  }
+  if (!report.has_mold()) return std::string();
+  jobs::MoldParameters tube;
+  tube.nozzle_vertex = report.mold().nozzle_vertex();
+  tube.tube_radius_mm = report.mold().tube_radius_mm();
+  tube.tube_length_mm = report.mold().tube_length_mm();
+  Result<TriMesh> mold = jobs::design_mold(rest, tube);
+  if (!mold) return std::string();  // the report names the tube, but it no longer builds: no mold
+  return write_mesh_to_memory(*mold, "stl");
+}
+
+}  // namespace
 
 const JobKind* job_kind_for(const v1::JobSpec& spec) {
   switch (spec.kind_case()) {
@@ -38,7 +85,24 @@ ServiceStatus JobKind::fill_result(const store::ResultRecord& stored, v1::MeshFo
   reply->mutable_rest_mesh()->set_data(write_mesh_to_memory(*rest, extension));
   reply->mutable_inflated_mesh()->set_format(format);
   reply->mutable_inflated_mesh()->set_data(write_mesh_to_memory(*inflated, extension));
-  reply->set_report_json(stored.report_json);
+  if (ServiceStatus report = fill_report(stored, reply); !report.ok()) return report;
+  if (proto_kind() == v1::JOB_KIND_DESIGN) {
+    Result<std::string> mold = mold_stl(stored, *rest, reply->design_report());
+    if (!mold) return ServiceStatus::error(StatusCode::Internal, mold.error());
+    if (!mold->empty()) {
+      reply->mutable_mold_mesh()->set_format(v1::MESH_FORMAT_STL);
+      reply->mutable_mold_mesh()->set_data(std::move(*mold));
+    }
+  }
+  return ServiceStatus::success();
+}
+
+ServiceStatus JobKind::fill_report(const store::ResultRecord& stored, v1::JobResult* reply) const {
+  google::protobuf::Message* report = report_of(proto_kind(), reply);
+  if (report == nullptr) return ServiceStatus::error(StatusCode::Internal, "this job kind has no report");
+  const bool read = stored.report.empty() ? read_legacy_report(proto_kind(), stored.report_json, report)
+                                          : report->ParseFromString(stored.report);
+  if (!read) return ServiceStatus::error(StatusCode::Internal, "the stored report is unreadable");
   return ServiceStatus::success();
 }
 

@@ -2,6 +2,7 @@
 #include "jobs/simulate_job.hpp"
 #include "mesh/mesh_io.hpp"
 #include "service/job_kind.hpp"
+#include "service/job_reports.hpp"
 #include "store/mesh_blob.hpp"
 
 namespace balloon::service {
@@ -77,7 +78,7 @@ class SimulateKind final : public JobKind {
     result.converged = outcome.result.converged;
     result.rest_mesh = store::encode_mesh_blob(input.rest);
     result.inflated_mesh = store::encode_mesh_blob(TriMesh{outcome.result.deformed, input.rest.faces});
-    result.report_json = outcome.report_json;
+    result.report = simulate_report(input, outcome.result).SerializeAsString();
     std::string message = outcome.result.converged
                               ? "completed: converged in " + format_number(outcome.result.time_s) + " s"
                               : "completed without converging: " + outcome.result.message;

@@ -45,10 +45,11 @@ constexpr const char* MARK_FAILED =
     "UPDATE jobs SET state = 'failed', error = ?, finished_ms = ? WHERE id = ? AND state IN ('queued', 'running')";
 
 constexpr const char* INSERT_RESULT =
-    "INSERT OR REPLACE INTO results (job_row, converged, rest_mesh, inflated_mesh, report_json, created_ms) "
-    "VALUES (?, ?, ?, ?, ?, ?)";
+    "INSERT OR REPLACE INTO results (job_row, converged, rest_mesh, inflated_mesh, report_json, created_ms, report, "
+    "mold_mesh) VALUES (?, ?, ?, ?, ?, ?, ?, ?)";
 constexpr const char* SELECT_RESULT =
-    "SELECT converged, rest_mesh, inflated_mesh, report_json, created_ms FROM results WHERE job_row = ?";
+    "SELECT converged, rest_mesh, inflated_mesh, report_json, created_ms, report, mold_mesh FROM results "
+    "WHERE job_row = ?";
 
 constexpr const char* CLEAR_OLD_SHAPES =
     "UPDATE progress SET shape = NULL WHERE job_row = ? AND shape IS NOT NULL";
@@ -68,7 +69,8 @@ constexpr const char* DELETE_FINISHED_BEFORE =
 // length() of a BLOB reads its size, not its bytes.
 constexpr const char* SELECT_STORED_BYTES =
     "SELECT (SELECT COALESCE(SUM(LENGTH(spec) + LENGTH(summary) + LENGTH(error)), 0) FROM jobs WHERE owner = ?) + "
-    "(SELECT COALESCE(SUM(LENGTH(r.rest_mesh) + LENGTH(r.inflated_mesh) + LENGTH(CAST(r.report_json AS BLOB))), 0) "
+    "(SELECT COALESCE(SUM(LENGTH(r.rest_mesh) + LENGTH(r.inflated_mesh) + LENGTH(CAST(r.report_json AS BLOB)) + "
+    "COALESCE(LENGTH(r.report), 0) + COALESCE(LENGTH(r.mold_mesh), 0)), 0) "
     " FROM results AS r JOIN jobs AS j ON j.id = r.job_row WHERE j.owner = ?) + "
     "(SELECT COALESCE(SUM(COALESCE(LENGTH(p.shape), 0) + 64), 0) "
     " FROM progress AS p JOIN jobs AS j ON j.id = p.job_row WHERE j.owner = ?)";
@@ -214,15 +216,19 @@ bool JobStore::mark_completed(std::int64_t row_id, const ResultRecord& result) {
   const std::int64_t now = now_ms();
   m_store.database().prepare(MARK_COMPLETED).bind(1, result.converged ? 1 : 0).bind(2, now).bind(3, row_id).run();
   if (m_store.database().changes() != 1) return false;  // the transaction rolls back
-  m_store.database()
-      .prepare(INSERT_RESULT)
-      .bind(1, row_id)
+  Statement insert = m_store.database().prepare(INSERT_RESULT);
+  insert.bind(1, row_id)
       .bind(2, result.converged ? 1 : 0)
       .bind_blob(3, result.rest_mesh)
       .bind_blob(4, result.inflated_mesh)
       .bind(5, result.report_json)
       .bind(6, now)
-      .run();
+      .bind_blob(7, result.report);
+  if (result.mold_mesh.empty())
+    insert.bind_null(8);
+  else
+    insert.bind_blob(8, result.mold_mesh);
+  insert.run();
   transaction.commit();
   return true;
 }
@@ -318,6 +324,8 @@ std::optional<ResultRecord> JobStore::result(std::int64_t row_id) {
   result.inflated_mesh = statement.column_blob(2);
   result.report_json = statement.column_text(3);
   result.created_ms = statement.column_int64(4);
+  if (!statement.column_is_null(5)) result.report = statement.column_blob(5);
+  if (!statement.column_is_null(6)) result.mold_mesh = statement.column_blob(6);
   return result;
 }
 

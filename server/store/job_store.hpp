@@ -55,12 +55,14 @@ struct JobRecord {
   std::optional<ProgressRecord> last_progress;  ///< filled by find() and list()
 };
 
-/// A finished job's output: meshes as mesh blobs (mesh_blob.hpp) and the report JSON.
+/// A finished job's output: meshes as mesh blobs (mesh_blob.hpp) and the report.
 struct ResultRecord {
   bool converged = false;
   std::string rest_mesh;
   std::string inflated_mesh;
-  std::string report_json;
+  std::string report;       ///< the serialized report message (opaque here); empty for results stored before it
+  std::string report_json;  ///< the report as JSON, kept only by results stored before `report` (else empty)
+  std::string mold_mesh;    ///< design: the mold as a mesh blob; empty when there is none
   std::int64_t created_ms = 0;
 };
 

@@ -81,8 +81,15 @@ CREATE TABLE design_checkpoints (
 );
 )sql";
 
+// Version 4: typed reports (a serialized balloon.v1 report message; report_json is left '' and is read only
+// for results stored before) and the mold the server built with the result (a mesh blob; NULL when none).
+constexpr const char* MIGRATION_4 = R"sql(
+ALTER TABLE results ADD COLUMN report BLOB;
+ALTER TABLE results ADD COLUMN mold_mesh BLOB;
+)sql";
+
 const std::vector<const char*>& migrations() {
-  static const std::vector<const char*> list = {MIGRATION_1, MIGRATION_2, MIGRATION_3};
+  static const std::vector<const char*> list = {MIGRATION_1, MIGRATION_2, MIGRATION_3, MIGRATION_4};
   return list;
 }
 

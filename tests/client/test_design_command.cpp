@@ -140,5 +140,38 @@ TEST_F(DesignCommand, SmallDesignWritesTheFiveFilesWithTheContractKeys) {
   EXPECT_GT(mold->face_count(), rest->face_count());  // the tube adds faces
 }
 
+// A design stopped before its start was ever inflated has no error to report: report.json says null, never
+// 0, and `jobs result` writes the same report.json (and the same files) for that job as `balloon design` did.
+TEST_F(DesignCommand, ADesignWithoutErrorsReportsNullAndJobsResultWritesTheSameFiles) {
+  const std::string db = s_scratch->file("no-errors.db");
+  const std::string from_design = s_scratch->file("no-errors-design"), from_result = s_scratch->file("no-errors-result");
+  // A budget of a microsecond ends the design while it inflates the start: a completed job with no error.
+  const ProcessResult designed = run({"--db", db, "design", bumpy(), "--material", "silicone", "--resolution", "0",
+                                      "--max-time", "0.000001", "--out-dir", from_design, "--json"});
+  ASSERT_EQ(designed.exit_code, 3) << designed.err;
+  const auto lines = split_lines(designed.out);
+  ASSERT_EQ(lines.size(), 1u) << designed.out;
+  const std::string& json = lines[0];
+  EXPECT_EQ(json_field(json, "stop_reason"), "\"time_limit\"") << json;
+  EXPECT_EQ(json_field(json, "converged"), "false") << json;
+  for (const char* key : {"avg_error_mm", "max_error_mm", "avg_error_rel", "max_error_rel", "baseline_avg_error_mm",
+                          "baseline_max_error_mm"})
+    EXPECT_EQ(json_field(json, key), "null") << key << " in " << json;
+  EXPECT_FALSE(json_field(json, "resumed_from_iteration").has_value()) << "absent when the design ran through";
+
+  const std::size_t at = designed.err.find("j-");
+  ASSERT_NE(at, std::string::npos) << designed.err;
+  const std::string id = designed.err.substr(at, 18);
+  const ProcessResult result = run({"--db", db, "jobs", "result", id, "--out-dir", from_result});
+  ASSERT_EQ(result.exit_code, 3) << result.err;
+  EXPECT_EQ(read_text(from_result + "/report.json"), json + "\n");
+  for (const auto& entry : std::filesystem::directory_iterator(from_design)) {
+    const std::string name = entry.path().filename().string();
+    EXPECT_EQ(read_text(from_result + "/" + name), read_text(entry.path().string())) << name;
+  }
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(from_result), std::filesystem::directory_iterator()),
+            std::distance(std::filesystem::directory_iterator(from_design), std::filesystem::directory_iterator()));
+}
+
 }  // namespace
 }  // namespace balloon::testing

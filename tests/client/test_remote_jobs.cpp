@@ -41,6 +41,11 @@ std::set<std::string> file_names(const std::string& directory) {
   return names;
 }
 
+std::string read_file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
 /// The id in `text` after `prefix` ("j-" and 16 hex digits), or "".
 std::string job_id_in(const std::string& text) {
   const auto at = text.find("j-");
@@ -175,6 +180,18 @@ TEST_F(RemoteJobs, SubmitDesignReturnsQueuedThenWatchAndResultWriteWhatDesignWri
   const std::set<std::string> five = {"rest.obj", "inflated.obj", "mold.stl", "report.json", "convergence.csv"};
   EXPECT_EQ(file_names(from_result), five);
   EXPECT_EQ(file_names(from_design), five);
+  // For one job, `jobs result` writes byte for byte what `balloon design` wrote: the server built the mold
+  // and one writer (contract::job_result_files) made every file.
+  const std::string design_id = job_id_in(designed.err);
+  ASSERT_EQ(design_id.rfind("j-", 0), 0u) << designed.err;
+  const std::string again = s_scratch->file("from-design-result");
+  const ProcessResult rewritten = run({"--server", server(), "jobs", "result", design_id, "--out-dir", again});
+  ASSERT_TRUE(rewritten.exit_code == 0 || rewritten.exit_code == 3) << rewritten.err;
+  EXPECT_EQ(file_names(again), five);
+  for (const std::string& name : five)
+    EXPECT_EQ(read_file_bytes(again + "/" + name), read_file_bytes(from_design + "/" + name)) << name;
+  const std::string report = read_file_bytes(again + "/report.json");
+  EXPECT_GT(std::stod(json_field(report, "avg_error_mm").value_or("-1")), 0.0) << report.substr(0, 400);
   const Result<TriMesh> rest = read_mesh(from_result + "/rest.obj");
   const Result<TriMesh> mold = read_mesh(from_result + "/mold.stl");
   ASSERT_TRUE(rest.ok() && mold.ok());

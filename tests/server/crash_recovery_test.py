@@ -185,7 +185,7 @@ def job_request(pb, rng, data_dir, request_id):
         scale = rng.choice([(1.0, 1.0, 1.0), (1.3, 1.0, 0.8)])
         spec = pb.JobSpec(design=pb.DesignJob(
             target_mesh=pb.MeshFile(data=icosphere_obj(2, 10.0, scale), format=pb.MESH_FORMAT_OBJ),
-            material=pb.MaterialRef(name="latex"), thickness_mm=0.5, resolution=-1, max_time_s=2.0))
+            material=pb.MaterialRef(name="latex"), thickness_mm=0.5, resolution=0, max_time_s=2.0))
     else:
         with open(os.path.join(data_dir, "materials", "treloar1944_ut.csv"), "rb") as f:
             csv = f.read()
@@ -323,7 +323,7 @@ def main():
         # A job that crashes the server every time it runs: kill whenever it is RUNNING, three times.
         heavy = pb.SubmitJobRequest(request_id="crasher", spec=pb.JobSpec(design=pb.DesignJob(
             target_mesh=pb.MeshFile(data=icosphere_obj(2, 10.0), format=pb.MESH_FORMAT_OBJ),
-            material=pb.MaterialRef(name="latex"), thickness_mm=0.5, resolution=-1, max_time_s=60.0)))
+            material=pb.MaterialRef(name="latex"), thickness_mm=0.5, resolution=0, max_time_s=60.0)))
         crasher = api.retrying(api.submit, heavy, "alice")[0].job.id
         for attempt in range(1, 4):
             deadline = time.time() + 30

@@ -5,7 +5,6 @@ grpc_tools is not packaged). Starts a balloon-server on an ephemeral port and ru
 
 Usage: python_client_test.py BALLOON_SERVER_BINARY
 """
-import json
 import math
 import os
 import subprocess
@@ -72,10 +71,12 @@ def main():
             result = get_result(pb.GetResultRequest(job_id=job.id, format=pb.MESH_FORMAT_OBJ), timeout=10)
             vertices = [l for l in result.inflated_mesh.data.decode().splitlines() if l.startswith("v ")]
             assert len(vertices) == 12, len(vertices)
-            report = json.loads(result.report_json)
-            assert report["converged"] is True
-            assert abs(report["volume_ratio"] - 2.0) < 1e-6, report["volume_ratio"]
-            assert report["vertices"] == 12
+            # The report is typed (SimulateReport), no JSON to parse.
+            assert result.WhichOneof("report") == "simulate_report", result.WhichOneof("report")
+            report = result.simulate_report
+            assert report.converged is True
+            assert abs(report.volume_ratio - 2.0) < 1e-6, report.volume_ratio
+            assert report.vertices == 12
 
             try:
                 submit(pb.SubmitJobRequest(spec=pb.JobSpec(simulate=pb.SimulateJob(
@@ -85,7 +86,7 @@ def main():
             except grpc.RpcError as error:
                 assert error.code() == grpc.StatusCode.INVALID_ARGUMENT, error
             print("python client: job %s completed, %d events, pressure %.4g kPa" %
-                  (job.id, len(events), report["pressure_kpa"]))
+                  (job.id, len(events), report.pressure_kpa))
             channel.close()
         finally:
             server.terminate()

@@ -112,7 +112,7 @@ v1::SubmitJobRequest good_design() {
   job->mutable_target_mesh()->set_data(small_sphere_obj());
   job->mutable_target_mesh()->set_format(v1::MESH_FORMAT_OBJ);
   job->mutable_material()->set_name("latex");
-  job->set_resolution(-1);  // never remesh: the catalogue is about the fields, not CGAL
+  job->set_resolution(0);  // never remesh: the catalogue is about the fields, not CGAL
   job->set_volume_ratio(4.0);
   request.mutable_spec()->set_time_limit_s(3.0);
   return request;
@@ -420,13 +420,16 @@ TEST(HostileInputs, CatalogueGetsItsStatusesAndTheServerStaysServingAndSmall) {
     submit_case("design max_time_s " + number_name(v), time, time_valid ? StatusCode::OK : StatusCode::INVALID_ARGUMENT,
                 time_valid ? "" : "max time must be a number of s >= 0");
   }
-  for (const int v : {-1, 49, std::numeric_limits<int>::max(), std::numeric_limits<int>::min()}) {
+  for (const int v : {0, -1, 49, std::numeric_limits<int>::max(), std::numeric_limits<int>::min()}) {
     v1::SubmitJobRequest resolution = good_design();
     resolution.mutable_spec()->mutable_design()->set_resolution(v);
-    const bool never = v < 0;  // < 0 never remeshes: accepted
-    submit_case("design resolution " + std::to_string(v), resolution,
-                never ? StatusCode::OK : v == 49 ? StatusCode::INVALID_ARGUMENT : StatusCode::RESOURCE_EXHAUSTED,
-                never ? "" : v == 49 ? "resolution must be at least 50" : "over this server's limit");
+    // 0 keeps the target's mesh; a negative count has no meaning (there is no sentinel on the wire).
+    const StatusCode code = v == 0 ? StatusCode::OK
+                            : v == std::numeric_limits<int>::max() ? StatusCode::RESOURCE_EXHAUSTED
+                                                                   : StatusCode::INVALID_ARGUMENT;
+    submit_case("design resolution " + std::to_string(v), resolution, code,
+                v == 0 ? "" : v == 49 ? "resolution must be at least 50" : v < 0 ? "resolution must be >= 0"
+                                                                                 : "over this server's limit");
   }
   for (const int v : {-1, 101, std::numeric_limits<int>::max()}) {
     v1::SubmitJobRequest samples = good_design();

@@ -25,7 +25,8 @@
 #include "http/static_files.hpp"
 #include "jobs/design_job.hpp"
 #include "jobs/fit_job.hpp"
-#include "jobs/json_reader.hpp"
+#include "contract/job_result_files.hpp"
+#include "service/job_reports.hpp"
 #include "mesh/icosphere.hpp"
 #include "mesh/mesh_io.hpp"
 #include "net/network_address.hpp"
@@ -216,31 +217,6 @@ TEST(HttpGateway, StaticLookupRefusesTraversalAndFindsIndexFiles) {
   EXPECT_EQ(http::content_type_for("m.stl"), "model/stl");
 }
 
-TEST(HttpGateway, JsonReaderReadsWhatTheReportsHoldAndRefusesBrokenText) {
-  const Result<jobs::JsonValue> value =
-      jobs::parse_json(R"({"a":[1,-2.5e3,true,null],"s":"x\"\\\u00e9\ud83d\ude00\n","o":{}})");
-  ASSERT_TRUE(value.ok()) << value.error();
-  ASSERT_NE(value->find("a"), nullptr);
-  EXPECT_EQ(value->find("a")->items.size(), 4u);
-  EXPECT_DOUBLE_EQ(value->find("a")->items[1].number, -2500.0);
-  EXPECT_EQ(value->find("s")->text, "x\"\\\xc3\xa9\xf0\x9f\x98\x80\n");
-  for (const char* bad : {"", "{", "{\"a\":}", "[1,]", "{\"a\":1} x", "+1", "\"\x01\""})
-    EXPECT_FALSE(jobs::parse_json(bad).ok()) << bad;
-}
-
-TEST(HttpGateway, MoldFromReportNamesWhyThereIsNoMold) {
-  const TriMesh rest = make_icosphere(10.0, 2);
-  const Result<TriMesh> none = jobs::mold_from_report(rest, R"({"mold_problem":"no nozzle for the mold: too flat"})");
-  ASSERT_FALSE(none.ok());
-  EXPECT_NE(none.error().find("too flat"), std::string::npos) << none.error();
-  EXPECT_FALSE(jobs::mold_from_report(rest, "not json").ok());
-  EXPECT_FALSE(jobs::mold_from_report(rest, R"({"mold":{"nozzle_vertex":5}})").ok());
-  const Result<TriMesh> mold =
-      jobs::mold_from_report(rest, R"({"mold":{"nozzle_vertex":0,"tube_radius_mm":1.5,"tube_length_mm":4}})");
-  ASSERT_TRUE(mold.ok()) << mold.error();
-  EXPECT_GT(mold->vertex_count(), rest.vertex_count());
-}
-
 TEST(HttpGateway, LoopbackTestParsesTheAddress) {
   for (const char* host : {"localhost", "LocalHost", "127.0.0.1", "127.255.255.254", "127.0.1.1", "::1",
                            "0:0:0:0:0:0:0:1", "::ffff:127.0.0.1"})
@@ -398,7 +374,9 @@ TEST(HttpGateway, SimulateJobStreamsProgressAndServesItsMeshes) {
   const auto job_result = parse<v1::JobResult>(result->body);  // bytes came as base64
   EXPECT_EQ(job_result.kind(), v1::JOB_KIND_SIMULATE);
   EXPECT_TRUE(job_result.converged());
-  EXPECT_NE(job_result.report_json().find("pressure_kpa"), std::string::npos);
+  ASSERT_TRUE(job_result.has_simulate_report());
+  EXPECT_GT(job_result.simulate_report().pressure_kpa(), 0.0);
+  EXPECT_FALSE(job_result.has_mold_mesh()) << "only a design has a mold";
 
   for (const char* name : {"rest.obj", "inflated.obj"}) {
     auto file = client->Get("/api/v1/jobs/" + job_id + "/files/" + name);
@@ -412,8 +390,8 @@ TEST(HttpGateway, SimulateJobStreamsProgressAndServesItsMeshes) {
   }
   auto report = client->Get("/api/v1/jobs/" + job_id + "/files/report.json");
   ASSERT_TRUE(report);
-  EXPECT_EQ(report->body, job_result.report_json());
-  for (const char* name : {"mold.stl", "fit.svg", "secrets.txt"}) {
+  EXPECT_EQ(report->body, contract::result_report_json(job_result));
+  for (const char* name : {"mold.stl", "convergence.csv", "fit.svg", "secrets.txt"}) {
     auto missing = client->Get("/api/v1/jobs/" + job_id + "/files/" + name);
     ASSERT_TRUE(missing);
     EXPECT_EQ(missing->status, 404) << name;
@@ -431,12 +409,12 @@ TEST(HttpGateway, SimulateJobStreamsProgressAndServesItsMeshes) {
   EXPECT_EQ(parse<v1::ListJobsResponse>(none->body).jobs_size(), 0);
 }
 
-TEST(HttpGateway, DesignJobServesTheSameMoldTheCliBuilds) {
+TEST(HttpGateway, DesignJobServesTheMoldTheServerBuilt) {
   ScratchDir scratch;
   HttpServer server(scratch, {"--quiet", "--workers", "1"});
   auto client = server.client();
   const std::string body = R"({"spec":{"design":{"target_mesh":{"data":")" + base64(sphere_obj(2)) +
-                           R"(","format":"MESH_FORMAT_OBJ"},"material":{"name":"latex"},"resolution":-1,)"
+                           R"(","format":"MESH_FORMAT_OBJ"},"material":{"name":"latex"},"resolution":0,)"
                            R"("max_time_s":5}}})";
   const std::string job_id = submit(*client, body);
   ASSERT_FALSE(job_id.empty());
@@ -463,10 +441,21 @@ TEST(HttpGateway, DesignJobServesTheSameMoldTheCliBuilds) {
   const Result<TriMesh> mold_mesh = read_mesh_from_memory(mold->body, "stl");
   ASSERT_TRUE(mold_mesh.ok()) << mold_mesh.error();
   EXPECT_GT(mold_mesh->face_count(), rest_mesh->face_count());  // the rest shape plus a tube
-  // Byte for byte what the CLI writes: the same function on the same stored data.
-  const Result<TriMesh> expected = jobs::mold_from_report(*rest_mesh, report->body);
-  ASSERT_TRUE(expected.ok()) << expected.error();
-  EXPECT_EQ(mold->body, write_mesh_to_memory(*expected, "stl"));
+  // Byte for byte the mold GetResult returns (what the CLI writes), and the report of the same result.
+  auto result = client->Get("/api/v1/jobs/" + job_id + "/result");
+  ASSERT_TRUE(result);
+  ASSERT_EQ(result->status, 200) << result->body;
+  const auto job_result = parse<v1::JobResult>(result->body);
+  EXPECT_EQ(job_result.mold_mesh().format(), v1::MESH_FORMAT_STL);
+  EXPECT_EQ(mold->body, job_result.mold_mesh().data());
+  EXPECT_EQ(report->body, contract::result_report_json(job_result));
+  ASSERT_TRUE(job_result.design_report().has_mold());
+  EXPECT_GT(job_result.design_report().mold().tube_radius_mm(), 0.0);
+  auto convergence = client->Get("/api/v1/jobs/" + job_id + "/files/convergence.csv");
+  ASSERT_TRUE(convergence);
+  ASSERT_EQ(convergence->status, 200) << convergence->body;
+  EXPECT_EQ(convergence->body.rfind("time_s,iteration,avg_error_mm,max_error_mm,residual_norm\n", 0), 0u);
+  EXPECT_EQ(convergence->body, contract::convergence_csv(job_result.design_report().convergence()));
 }
 
 TEST(HttpGateway, FitJobServesTheSamePlotAsTheCli) {
@@ -499,7 +488,11 @@ TEST(HttpGateway, FitJobServesTheSamePlotAsTheCli) {
   files[0].test = "equibiaxial";
   const Result<jobs::FitInput> input = jobs::prepare_fit(files, "hart-smith");
   ASSERT_TRUE(input.ok()) << input.error();
-  const Result<jobs::FitOutcome> outcome = jobs::fit_outcome_from_json(*input, report->body);
+  auto result = client->Get("/api/v1/jobs/" + job_id + "/result");
+  ASSERT_TRUE(result);
+  const auto job_result = parse<v1::JobResult>(result->body);
+  EXPECT_EQ(report->body, contract::result_report_json(job_result));
+  const Result<jobs::FitOutcome> outcome = service::fit_outcome_from_report(*input, job_result.fit_report());
   ASSERT_TRUE(outcome.ok()) << outcome.error();
   EXPECT_EQ(plot->body, jobs::fit_plot_svg(*input, *outcome));
   for (const char* name : {"rest.obj", "mold.stl"}) {

@@ -70,20 +70,52 @@ TEST(JobStore, OnlyFinishedJobsAreDeletedAndTheirBytesGoWithThem) {
   ResultRecord result;
   result.rest_mesh = std::string(5000, 'r');
   result.inflated_mesh = std::string(5000, 'i');
-  result.report_json = "{}";
+  result.report = std::string(300, 'p');
+  result.mold_mesh = std::string(2000, 'm');
   ASSERT_TRUE(jobs.mark_completed(done.row_id, result));
   const std::int64_t before = jobs.stored_bytes("alice");
-  EXPECT_GE(before, 2 * 1000 + 10000);
+  EXPECT_GE(before, 2 * 1000 + 12300) << "the report and the mold count too";
   EXPECT_EQ(jobs.stored_bytes("bob"), 0);
   EXPECT_FALSE(jobs.delete_finished(running.row_id));
   EXPECT_TRUE(jobs.delete_finished(done.row_id));
   EXPECT_FALSE(jobs.find("j-done"));
   EXPECT_FALSE(jobs.result(done.row_id));
-  EXPECT_LE(jobs.stored_bytes("alice"), before - 11000);
+  EXPECT_LE(jobs.stored_bytes("alice"), before - 13300);
   // Retention: a job that finished before the cutoff goes, a running one stays.
   jobs.mark_failed(running.row_id, "x");
   EXPECT_EQ(jobs.delete_finished_before(now_ms() - 60000), 0);
   EXPECT_EQ(jobs.delete_finished_before(now_ms() + 1), 1);
+}
+
+// A result keeps its typed report and the mold the server built; a result without a mold reads back none.
+TEST(JobStore, ResultsKeepTheirReportAndMold) {
+  Store store(":memory:");
+  JobStore jobs(store);
+  const JobRecord design = queued_job(jobs, "j-design", "alice");
+  const JobRecord simulate = queued_job(jobs, "j-simulate", "alice");
+  ASSERT_TRUE(jobs.mark_running(design.row_id));
+  ASSERT_TRUE(jobs.mark_running(simulate.row_id));
+  ResultRecord with_mold;
+  with_mold.converged = true;
+  with_mold.rest_mesh = "rest";
+  with_mold.inflated_mesh = "inflated";
+  with_mold.report = std::string("\x08\x01\x12\x07matched", 11);  // binary: NUL-free is not assumed
+  with_mold.mold_mesh = std::string("mold\0blob", 9);
+  ASSERT_TRUE(jobs.mark_completed(design.row_id, with_mold));
+  ResultRecord without_mold = with_mold;
+  without_mold.mold_mesh.clear();
+  ASSERT_TRUE(jobs.mark_completed(simulate.row_id, without_mold));
+
+  const std::optional<ResultRecord> read = jobs.result(design.row_id);
+  ASSERT_TRUE(read);
+  EXPECT_TRUE(read->converged);
+  EXPECT_EQ(read->report, with_mold.report);
+  EXPECT_EQ(read->mold_mesh, with_mold.mold_mesh);
+  EXPECT_EQ(read->report_json, "") << "new results keep the typed report only";
+  const std::optional<ResultRecord> plain = jobs.result(simulate.row_id);
+  ASSERT_TRUE(plain);
+  EXPECT_EQ(plain->mold_mesh, "");
+  EXPECT_EQ(plain->report, with_mold.report);
 }
 
 }  // namespace

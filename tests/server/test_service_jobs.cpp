@@ -9,11 +9,13 @@
 #include <fstream>
 #include <sstream>
 
+#include "contract/job_result_files.hpp"
 #include "jobs/fit_job.hpp"
 #include "mesh/icosphere.hpp"
 #include "mesh/mesh_checks.hpp"
 #include "mesh/mesh_io.hpp"
 #include "server_process.hpp"
+#include "service/job_reports.hpp"
 #include "scratch_dir.hpp"
 
 namespace balloon::testing {
@@ -26,13 +28,6 @@ std::string read_text(const std::string& path) {
   std::stringstream bytes;
   bytes << in.rdbuf();
   return bytes.str();
-}
-
-/// The number after `"key":` in a flat JSON text (the first occurrence), NaN if absent.
-double json_number(const std::string& json, const std::string& key) {
-  const size_t at = json.find("\"" + key + "\":");
-  if (at == std::string::npos) return std::nan("");
-  return std::stod(json.substr(at + key.size() + 3));
 }
 
 v1::SubmitJobRequest treloar_fit_request(const std::string& model, const std::string& name) {
@@ -76,14 +71,17 @@ TEST(ServiceJobs, FitJobFitsTreloarStoresTheMaterialAndReturnsTheReport) {
   ASSERT_TRUE(got.ok()) << got.error_message();
   EXPECT_EQ(result.kind(), v1::JOB_KIND_FIT_MATERIAL);
   EXPECT_TRUE(result.rest_mesh().data().empty()) << "a fit has no meshes";
-  const std::string& json = result.report_json();
-  ASSERT_EQ(json.front(), '{') << json;
-  EXPECT_NE(json.find("\"model\":\"hart-smith\""), std::string::npos) << json;
-  EXPECT_EQ(json_number(json, "points"), 16.0) << json;
+  ASSERT_TRUE(result.has_fit_report());
+  ASSERT_EQ(result.fit_report().fits_size(), 1);
+  const v1::FitModelReport& fit = result.fit_report().fits(0);
+  EXPECT_EQ(fit.model(), "hart-smith");
+  EXPECT_EQ(fit.points(), 16);
   // The CLI measured rms 0.0189 MPa for Hart-Smith on these 16 points (tests/client/test_fit_material_command).
-  EXPECT_GT(json_number(json, "rms_residual"), 0.0) << json;
-  EXPECT_LT(json_number(json, "rms_residual"), 0.03) << json;
-  EXPECT_GT(json_number(json, "G"), 0.0) << json;
+  EXPECT_GT(fit.rms_residual(), 0.0);
+  EXPECT_LT(fit.rms_residual(), 0.03);
+  ASSERT_EQ(fit.params().count("G"), 1u);
+  EXPECT_GT(fit.params().at("G"), 0.0);
+  EXPECT_EQ(result.fit_report().plot_svg().rfind("<svg", 0), 0u);
 
   // The best fit is now this tenant's material, with its provenance.
   grpc::ClientContext material_context;
@@ -113,19 +111,28 @@ TEST(ServiceJobs, FitReportReadsBackToTheSameTextPlotAndJson) {
   const Result<jobs::FitOutcome> fitted = jobs::run_fit(*input);
   ASSERT_TRUE(fitted.ok()) << fitted.error();
   ASSERT_EQ(fitted->fits.size(), 3u);
-  const std::string report = jobs::fit_report_json(*input, *fitted);
+  const std::string json = jobs::fit_report_json(*input, *fitted);
+  const v1::FitReport report = service::fit_report(*input, *fitted);
+  EXPECT_EQ(report.best_fit(), jobs::best_fit_index(*fitted));
 
-  Result<jobs::FitOutcome> read = jobs::fit_outcome_from_json(*input, report);
+  Result<jobs::FitOutcome> read = service::fit_outcome_from_report(*input, report);
   ASSERT_TRUE(read.ok()) << read.error();
   read->time_s = fitted->time_s;
-  EXPECT_EQ(jobs::fit_report_json(*input, *read), report);
+  EXPECT_EQ(jobs::fit_report_json(*input, *read), json);
   EXPECT_EQ(jobs::fit_summary_text(*input, *read), jobs::fit_summary_text(*input, *fitted));
   EXPECT_EQ(jobs::fit_plot_svg(*input, *read), jobs::fit_plot_svg(*input, *fitted));
   EXPECT_EQ(jobs::best_fit_index(*read), jobs::best_fit_index(*fitted));
 
   // A report that does not match the input is refused, not half-read.
-  EXPECT_FALSE(jobs::fit_outcome_from_json(*input, "{\"model\":\"hart-smith\"}").ok());
-  EXPECT_FALSE(jobs::fit_outcome_from_json(*input, report.substr(0, report.size() / 2)).ok());
+  v1::FitReport one_fit;
+  one_fit.add_fits()->set_model("hart-smith");
+  EXPECT_FALSE(service::fit_outcome_from_report(*input, one_fit).ok());
+  v1::FitReport no_sets = report;
+  no_sets.mutable_fits(0)->clear_sets();
+  EXPECT_FALSE(service::fit_outcome_from_report(*input, no_sets).ok());
+  v1::FitReport no_constant = report;
+  no_constant.mutable_fits(1)->mutable_params()->clear();
+  EXPECT_FALSE(service::fit_outcome_from_report(*input, no_constant).ok());
 }
 
 TEST(ServiceJobs, BadFitJobsAreRefusedAtSubmitAndPresetsCannotBeOverwritten) {
@@ -172,7 +179,7 @@ TEST(ServiceJobs, DesignJobStreamsIntermediateMeshesAndReturnsAReport) {
   job->mutable_target_mesh()->set_format(v1::MESH_FORMAT_OBJ);
   job->mutable_material()->set_name("latex");
   job->set_thickness_mm(0.5);
-  job->set_resolution(-1);  // never remesh: keep the 162-vertex sphere
+  job->set_resolution(0);  // never remesh: keep the 162-vertex sphere
   job->set_max_time_s(20.0);
   request.mutable_spec()->set_progress_mesh_every(1);
   std::string job_id;
@@ -216,16 +223,26 @@ TEST(ServiceJobs, DesignJobStreamsIntermediateMeshesAndReturnsAReport) {
   const grpc::Status got = stub->GetResult(&result_context, result_request, &result);
   ASSERT_TRUE(got.ok()) << got.error_message();
   EXPECT_EQ(result.kind(), v1::JOB_KIND_DESIGN);
-  const std::string& json = result.report_json();
+  ASSERT_TRUE(result.has_design_report());
+  const v1::DesignReport& report = result.design_report();
+  const std::string json = contract::result_report_json(result);
   for (const char* key : {"avg_error_mm", "max_error_mm", "avg_error_rel", "bbox_diag_mm", "iterations", "time_s",
                           "baseline_avg_error_mm", "material", "preparation"})
     EXPECT_NE(json.find(std::string("\"") + key + "\":"), std::string::npos) << "missing " << key << " in " << json;
-  const double avg_error = json_number(json, "avg_error_mm");
-  EXPECT_GE(avg_error, 0.0);
-  EXPECT_LE(avg_error, json_number(json, "max_error_mm"));
+  ASSERT_TRUE(report.has_avg_error_mm() && report.has_max_error_mm() && report.has_baseline_avg_error_mm()) << json;
+  EXPECT_GE(report.avg_error_mm(), 0.0);
+  EXPECT_LE(report.avg_error_mm(), report.max_error_mm());
   // Better than the untouched target used as the rest shape (bbox diagonal of the r = 10 mm sphere ~ 34.6 mm).
-  EXPECT_LT(avg_error, json_number(json, "baseline_avg_error_mm")) << json;
-  EXPECT_LE(json_number(json, "time_s"), 25.0);
+  EXPECT_LT(report.avg_error_mm(), report.baseline_avg_error_mm()) << json;
+  EXPECT_LE(report.time_s(), 25.0);
+  EXPECT_FALSE(report.has_resumed_from_iteration()) << "it ran through";
+  EXPECT_EQ(json.find("resumed_from_iteration"), std::string::npos) << json;
+  // The server built the mold with the result: binary STL of the rest shape plus its tube.
+  ASSERT_TRUE(report.has_mold()) << report.mold_problem();
+  EXPECT_EQ(result.mold_mesh().format(), v1::MESH_FORMAT_STL);
+  const Result<TriMesh> mold = read_mesh_from_memory(result.mold_mesh().data(), "stl");
+  ASSERT_TRUE(mold.ok()) << mold.error();
+  EXPECT_GT(mold->face_count(), 320);
   const Result<TriMesh> rest = read_mesh_from_memory(result.rest_mesh().data(), "obj");
   ASSERT_TRUE(rest.ok()) << rest.error();
   EXPECT_EQ(rest->vertex_count(), 162);

@@ -352,5 +352,34 @@ TEST(ServiceLifecycle, RetentionDeletesFinishedJobsOlderThanItsDaysAtStart) {
   EXPECT_TRUE(get_job(*stub, recent_job, &job).ok());
 }
 
+// A result stored before reports were typed (schema version 3: the report as JSON text only) still reads
+// back as a typed report after the upgrade: its keys are the message's fields, null is absent.
+TEST(ServiceLifecycle, AReportStoredAsJsonBeforeTheUpgradeReadsBackTyped) {
+  ScratchDir scratch;
+  const std::string db = scratch.file("jobs.db");
+  std::string job_id;
+  {
+    ServerProcess server(db, {"--workers", "1"});
+    auto stub = server.stub();
+    ASSERT_TRUE(submit(*stub, simulate_request(2, 2.0), &job_id).ok());
+    ASSERT_EQ(wait_for(*stub, job_id, v1::JOB_STATE_COMPLETED, 30).state(), v1::JOB_STATE_COMPLETED);
+  }
+  run_sql(db, "UPDATE results SET report = NULL, report_json = '{\"converged\":true,\"pressure_kpa\":5.5,"
+              "\"control\":\"volume_ratio\",\"target_volume_ratio\":2,\"vertices\":162,\"a_key_since_removed\":null}' "
+              "WHERE job_row = (SELECT id FROM jobs WHERE job_id = '" + job_id + "')");
+  ServerProcess restarted(db, {"--workers", "1"});
+  auto stub = restarted.stub();
+  grpc::ClientContext context;
+  v1::GetResultRequest request;
+  request.set_job_id(job_id);
+  v1::JobResult result;
+  const grpc::Status status = stub->GetResult(&context, request, &result);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_TRUE(result.has_simulate_report());
+  EXPECT_DOUBLE_EQ(result.simulate_report().pressure_kpa(), 5.5);
+  EXPECT_DOUBLE_EQ(result.simulate_report().target_volume_ratio(), 2.0);
+  EXPECT_EQ(result.simulate_report().vertices(), 162);
+}
+
 }  // namespace
 }  // namespace balloon::testing

@@ -133,7 +133,7 @@ export class ApiClient {
   }
 
   /**
-   * A result file (rest.obj, inflated.obj, mold.stl, report.json, fit.svg) as a Blob, with the token.
+   * A result file (rest.obj, inflated.obj, mold.stl, report.json, convergence.csv, fit.svg) as a Blob, with the token.
    * @returns {Promise<Blob>}
    */
   async fetch_file(job_id, file_name) {

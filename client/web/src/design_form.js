@@ -57,8 +57,6 @@ export class DesignForm {
     this.show_error('method', '');
     const method = this.m_section.querySelector('#method-select').value;
     if (method) design.method = method;
-    // On the wire resolution 0 means "server default" and < 0 "never remesh"; the form's 0 means keep.
-    if (design.resolution === 0) design.resolution = -1;
     return ok ? design : null;
   }
 }

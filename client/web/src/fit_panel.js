@@ -91,8 +91,7 @@ export class FitPanel {
     const elements = this.m_elements;
     elements.details.open = true;
     const result = await this.m_api.get_result(job_id);
-    const report = JSON.parse(result.report_json || '{}');
-    const fits = Array.isArray(report) ? report : [report];
+    const fits = result.fit_report?.fits ?? [];
     const table = elements.constants;
     table.replaceChildren();
     const header = table.insertRow();

@@ -18,7 +18,7 @@ import { SurfaceDistance } from './surface_distance.js';
  */
 
 const FILES_BY_KIND = {
-  JOB_KIND_DESIGN: ['rest.obj', 'inflated.obj', 'mold.stl', 'report.json'],
+  JOB_KIND_DESIGN: ['rest.obj', 'inflated.obj', 'mold.stl', 'report.json', 'convergence.csv'],
   JOB_KIND_SIMULATE: ['rest.obj', 'inflated.obj', 'report.json'],
 };
 
@@ -350,12 +350,8 @@ export class JobPanel {
       return;
     }
     if (this.m_job_id !== job.id) return;
-    let report = {};
-    try {
-      report = JSON.parse(result.report_json || '{}');
-    } catch {
-      report = {};
-    }
+    // The typed report of the job's kind (the gateway's JSON of JobResult); an error never computed is absent.
+    const report = result.design_report ?? result.simulate_report ?? {};
     // The report knows the exact scale the server applied to the target.
     const scale = report.preparation?.scale_factor;
     if (this.m_target && this.m_target.mesh && Number.isFinite(scale) && scale > 0 && scale !== this.m_target.scale)

@@ -1,0 +1,234 @@
+#include "service/job_reports.hpp"
+
+#include <limits>
+
+namespace balloon::service {
+namespace {
+
+namespace v1 = balloon::v1;
+
+/// a / b when both exist and b > 0; none otherwise (no baseline, no design, or a design with zero error).
+std::optional<double> ratio(const std::optional<double>& a, const std::optional<double>& b) {
+  if (!a || !b || !(*b > 0.0)) return std::nullopt;
+  return *a / *b;
+}
+
+}  // namespace
+
+v1::SimulateReport simulate_report(const jobs::SimulateInput& input, const InflationResult& result) {
+  v1::SimulateReport report;
+  report.set_converged(result.converged);
+  report.set_pressure_kpa(result.pressure_kpa);
+  report.set_volume_mm3(result.volume_mm3);
+  report.set_rest_volume_mm3(result.rest_volume_mm3);
+  report.set_volume_ratio(result.volume_ratio);
+  report.set_mean_stretch(result.mean_stretch);
+  report.set_max_stretch(result.max_stretch);
+  report.set_newton_iterations(result.newton_iterations);
+  report.set_factorizations(result.factorizations);
+  report.set_load_steps(result.load_steps);
+  report.set_residual_norm(result.residual_norm);
+  report.set_unstable_modes(result.unstable_modes);
+  report.set_time_s(result.time_s);
+  report.set_vertices(input.rest.vertex_count());
+  report.set_faces(input.rest.face_count());
+  report.set_material(material_spec(input.material));
+  report.set_material_name(input.material.name);
+  report.set_thickness_mm(input.thickness_mm);
+  if (input.control == InflationControl::Pressure) {
+    report.set_control("pressure");
+    report.set_target_pressure_kpa(input.pressure_kpa);
+  } else {
+    report.set_control("volume_ratio");
+    report.set_target_volume_ratio(input.volume_ratio);
+  }
+  report.set_flipped_orientation(input.flipped_orientation);
+  report.set_message(result.message);
+  return report;
+}
+
+v1::DesignReport design_report(const jobs::DesignInput& input, const jobs::DesignOutcome& outcome) {
+  const DesignResult& result = outcome.result;
+  const PreparedTarget& target = input.target;
+  v1::DesignReport report;
+  report.set_converged(result.converged);
+  report.set_stop_reason(design_stop_name(result.stop));
+  report.set_method(design_method_name(result.method));
+  if (const std::optional<double> value = result.avg_error_mm) report.set_avg_error_mm(*value);
+  if (const std::optional<double> value = result.max_error_mm) report.set_max_error_mm(*value);
+  if (const std::optional<double> value = result.avg_error_rel) report.set_avg_error_rel(*value);
+  if (const std::optional<double> value = result.max_error_rel) report.set_max_error_rel(*value);
+  report.set_bbox_diag_mm(result.bbox_diag_mm);
+  report.set_pressure_kpa(result.pressure_kpa);
+  report.set_volume_ratio(result.volume_ratio);
+  report.set_iterations(result.iterations);
+  report.set_time_s(result.time_s);
+  report.set_vertices(result.rest.vertex_count());
+  report.set_faces(result.rest.face_count());
+  for (const std::string& term : result.active_terms) report.add_active_terms(term);
+  if (const std::optional<double> value = result.baseline_avg_error_mm) report.set_baseline_avg_error_mm(*value);
+  if (const std::optional<double> value = result.baseline_max_error_mm) report.set_baseline_max_error_mm(*value);
+  if (const std::optional<double> value = ratio(result.baseline_avg_error_mm, result.bbox_diag_mm))
+    report.set_baseline_avg_error_rel(*value);
+  if (const std::optional<double> value = ratio(result.baseline_avg_error_mm, result.avg_error_mm))
+    report.set_improvement_over_baseline(*value);
+  report.set_distance_energy(result.distance_energy);
+  report.set_residual_norm(result.residual_norm);
+  report.set_material(material_spec(input.material));
+  report.set_material_name(input.material.name);
+  report.set_thickness_mm(input.parameters.thickness_mm);
+  report.set_start_scale(input.start_scale);
+  report.set_max_time_s(input.parameters.max_time_s);
+  report.set_cancelled(outcome.cancelled);
+  report.set_message(result.message);
+  if (result.resumed_from_iteration) report.set_resumed_from_iteration(*result.resumed_from_iteration);
+
+  v1::TargetPreparation* preparation = report.mutable_preparation();
+  preparation->set_summary(target.summary);
+  preparation->set_scale_factor(target.scale_factor);
+  preparation->set_reoriented(target.reoriented);
+  preparation->set_unreferenced_vertices_removed(target.unreferenced_vertices_removed);
+  preparation->set_remeshed(target.remeshed);
+  preparation->set_vertices_before(target.vertices_before);
+  preparation->set_vertices_after(target.vertices_after);
+  preparation->set_faces_before(target.faces_before);
+  preparation->set_faces_after(target.faces_after);
+  preparation->set_min_angle_before_deg(target.min_angle_before_deg);
+  preparation->set_min_angle_after_deg(target.min_angle_after_deg);
+  preparation->set_target_edge_length_mm(target.target_edge_length_mm);
+  preparation->set_bbox_diag_mm(target.bbox_diag_mm);
+  preparation->set_volume_mm3(target.volume_mm3);
+  preparation->set_self_intersecting(target.self_intersecting);
+
+  v1::DesignNozzle* nozzle = report.mutable_nozzle();
+  nozzle->set_requested(input.parameters.nozzle);
+  if (input.nozzle) {
+    nozzle->set_center_vertex(input.nozzle->center_vertex);
+    nozzle->set_radius_mm(input.nozzle->radius_mm);
+    nozzle->set_fixed_vertices(static_cast<int>(input.nozzle->vertices.size()));
+  }
+
+  if (outcome.mold) {
+    report.mutable_mold()->set_nozzle_vertex(outcome.mold->nozzle_vertex);
+    report.mutable_mold()->set_tube_radius_mm(outcome.mold->tube_radius_mm);
+    report.mutable_mold()->set_tube_length_mm(outcome.mold->tube_length_mm);
+  } else {
+    report.set_mold_problem(outcome.mold_problem);
+  }
+
+  if (outcome.tolerance) {
+    v1::ToleranceReport* tolerance = report.mutable_tolerance();
+    tolerance->set_samples(input.parameters.tolerance_samples);
+    tolerance->set_seed(jobs::TOLERANCE_SEED);
+    tolerance->set_control("volume_ratio");
+    for (const ThicknessToleranceLevel& level : outcome.tolerance->levels) {
+      v1::ToleranceLevel* out = tolerance->add_levels();
+      out->set_perturbation(level.perturbation);
+      out->set_mean_deviation_mm(level.mean_deviation_mm);
+      out->set_max_deviation_mm(level.max_deviation_mm);
+      out->set_samples(level.samples);
+      out->set_failed_samples(level.failed_samples);
+    }
+  }
+
+  v1::ConvergenceLog* log = report.mutable_convergence();
+  for (const ConvergenceSample& sample : result.log) {
+    log->add_time_s(sample.time_s);
+    log->add_iteration(sample.iteration);
+    log->add_avg_error_mm(sample.avg_error_mm);
+    log->add_max_error_mm(sample.max_error_mm);
+    log->add_residual_norm(sample.residual_norm);
+  }
+  return report;
+}
+
+v1::FitReport fit_report(const jobs::FitInput& input, const jobs::FitOutcome& outcome) {
+  v1::FitReport report;
+  for (const FitResult& fit : outcome.fits) {
+    v1::FitModelReport* out = report.add_fits();
+    out->set_model(model_name(fit.material.model));
+    out->set_spec(material_spec(fit.material));
+    const std::vector<std::string> names = parameter_names(fit.material.model);
+    for (size_t i = 0; i < names.size() && i < fit.material.params.size(); ++i)
+      (*out->mutable_params())[names[i]] = fit.material.params[i];
+    for (size_t i = 0; i < names.size() && i < fit.std_errors.size(); ++i)
+      (*out->mutable_std_errors())[names[i]] = fit.std_errors[i];
+    out->set_rms_residual(fit.rms_residual);
+    out->set_max_residual(fit.max_residual);
+    out->set_residual_unit(fit.residual_unit);
+    out->set_rms_relative_residual(fit.rms_relative_residual);
+    out->set_max_relative_residual(fit.max_relative_residual);
+    out->set_points(fit.points);
+    out->set_converged(fit.converged);
+    out->mutable_regimes()->set_data_inflection(fit.data_inflection);
+    out->mutable_regimes()->set_data_stiffening(fit.data_stiffening);
+    out->mutable_regimes()->set_model_inflection(fit.model_inflection);
+    out->mutable_regimes()->set_model_stiffening(fit.model_stiffening);
+    for (const SetFit& set : fit.sets) {
+      v1::FitSetReport* set_out = out->add_sets();
+      set_out->set_label(set.label);
+      set_out->set_test(test_kind_name(set.kind));
+      set_out->set_points(set.points);
+      set_out->set_rms_residual(set.rms_residual);
+      set_out->set_max_residual(set.max_residual);
+      set_out->set_residual_unit(set.residual_unit);
+    }
+    out->set_message(fit.message);
+  }
+  if (!outcome.fits.empty()) report.set_best_fit(jobs::best_fit_index(outcome));
+  report.set_plot_svg(jobs::fit_plot_svg(input, outcome));
+  return report;
+}
+
+Result<jobs::FitOutcome> fit_outcome_from_report(const jobs::FitInput& input, const v1::FitReport& report) {
+  if (static_cast<size_t>(report.fits_size()) != input.models.size())
+    return fail("the fit report has " + std::to_string(report.fits_size()) + " fit(s), " +
+                std::to_string(input.models.size()) + " were asked for");
+  jobs::FitOutcome outcome;
+  for (int m = 0; m < report.fits_size(); ++m) {
+    const v1::FitModelReport& in = report.fits(m);
+    const MaterialModel model = input.models[static_cast<size_t>(m)];
+    if (in.model() != model_name(model))
+      return fail("the fit report's model '" + in.model() + "' is not the " + model_name(model) + " fit asked for");
+    FitResult fit;
+    fit.material.model = model;
+    const std::vector<std::string> names = parameter_names(model);
+    for (size_t i = 0; i < names.size() && i < fit.material.params.size(); ++i) {
+      const auto value = in.params().find(names[i]);
+      if (value == in.params().end()) return fail("the fit report lacks the constant '" + names[i] + "'");
+      fit.material.params[i] = value->second;
+      if (const auto error = in.std_errors().find(names[i]); error != in.std_errors().end())
+        fit.std_errors.push_back(error->second);
+    }
+    fit.rms_residual = in.rms_residual();
+    fit.max_residual = in.max_residual();
+    fit.residual_unit = in.residual_unit();
+    fit.rms_relative_residual = in.rms_relative_residual();
+    fit.max_relative_residual = in.max_relative_residual();
+    fit.points = in.points();
+    fit.converged = in.converged();
+    fit.message = in.message();
+    fit.data_inflection = in.regimes().data_inflection();
+    fit.data_stiffening = in.regimes().data_stiffening();
+    fit.model_inflection = in.regimes().model_inflection();
+    fit.model_stiffening = in.regimes().model_stiffening();
+    if (static_cast<size_t>(in.sets_size()) != input.sets.size())
+      return fail("the fit report's sets do not match the data sent");
+    for (size_t s = 0; s < input.sets.size(); ++s) {
+      const v1::FitSetReport& set_in = in.sets(static_cast<int>(s));
+      SetFit set;
+      // Labels and tests come from the local input: the service sees no file names.
+      set.label = input.sets[s].label;
+      set.kind = input.sets[s].kind;
+      set.points = set_in.points();
+      set.rms_residual = set_in.rms_residual();
+      set.max_residual = set_in.max_residual();
+      set.residual_unit = set_in.residual_unit();
+      fit.sets.push_back(std::move(set));
+    }
+    outcome.fits.push_back(std::move(fit));
+  }
+  return outcome;
+}
+
+}  // namespace balloon::service
