@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <thread>
@@ -84,11 +85,15 @@ Result<bool> read_config_file(const std::string& path, std::vector<std::pair<std
 }  // namespace
 
 std::string default_web_root() {
-#ifdef BALLOON_WEB_ROOT
-  return BALLOON_WEB_ROOT;
+#ifdef BALLOON_WEB_ROOT_FROM_BIN
+  const std::filesystem::path from_bin = BALLOON_WEB_ROOT_FROM_BIN;
 #else
-  return "web";
+  const std::filesystem::path from_bin = "../share/balloon/web";
 #endif
+  std::error_code error;
+  const std::filesystem::path executable = std::filesystem::read_symlink("/proc/self/exe", error);
+  if (error || executable.empty()) return from_bin.string();  // no /proc: relative to the working directory
+  return (executable.parent_path() / from_bin).lexically_normal().string();
 }
 
 std::string server_usage() {

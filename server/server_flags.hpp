@@ -12,7 +12,7 @@ namespace balloon::server {
 struct ServerCommand {
   rpc::ServerConfig config;
   std::string http_address;  ///< --http HOST:PORT: also serve the JSON API and the page; empty: no HTTP
-  std::string web_root;      ///< --web-root DIR: the page's files (default: the page CMake built)
+  std::string web_root;      ///< --web-root DIR: the page's files (default: default_web_root())
   std::vector<std::string> http_allowed_origins;  ///< --http-allowed-origin URL (repeatable), checked
   std::string http_tls_cert_file;  ///< --http-tls-cert FILE: serve HTTPS with this PEM certificate chain
   std::string http_tls_key_file;   ///< --http-tls-key FILE: and this PEM key
@@ -26,7 +26,9 @@ struct ServerCommand {
 /// flags without dashes; `#` comments) before the remaining flags, which override it.
 Result<ServerCommand> parse_server_flags(const std::vector<std::string>& args);
 
-/// The compiled-in --web-root default (BALLOON_WEB_ROOT: <build>/client/web/dist).
+/// The --web-root default: share/balloon/web of the install prefix, found from the executable's folder
+/// (BALLOON_WEB_ROOT_FROM_BIN, e.g. "../share/balloon/web", so a moved prefix still finds its page). The build
+/// tree mirrors that layout with a link to the page CMake builds (server/CMakeLists.txt).
 std::string default_web_root();
 
 /// The --help text, with every flag's default.

@@ -10,21 +10,9 @@
 #include <thread>
 
 #include "exit_codes.hpp"
-#include "rpc/grpc_server.hpp"
+#include "embedded/embedded_server.hpp"
 
 namespace balloon::cli {
-
-std::string default_database_path() {
-  std::filesystem::path base;
-  if (const char* xdg = std::getenv("XDG_DATA_HOME"); xdg != nullptr && *xdg != '\0') {
-    base = xdg;
-  } else if (const char* home = std::getenv("HOME"); home != nullptr && *home != '\0') {
-    base = std::filesystem::path(home) / ".local" / "share";
-  } else {
-    base = std::filesystem::temp_directory_path();
-  }
-  return (base / "balloon" / "balloon.db").string();
-}
 
 ServiceConnection::~ServiceConnection() {
   m_stub.reset();
@@ -52,31 +40,20 @@ Result<std::unique_ptr<ServiceConnection>> ServiceConnection::open(const Connect
     connection->m_channel = grpc::CreateCustomChannel(options.server, credentials, arguments);
     connection->m_token = options.token;
   } else {
-    rpc::ServerConfig config;
-    config.service.db_path = options.db.empty() ? default_database_path() : options.db;
-    config.service.run_jobs = options.run_jobs;
-    config.service.workers = 0;  // number of cores
-    // The embedded server serves one user on this machine: no limits beyond the defaults' sanity, no
-    // tenant quotas, and the user's history is never deleted behind their back (no retention).
-    config.service.max_queued_per_tenant = 0;
-    config.service.max_running_per_tenant = 0;
-    config.service.max_watches_per_tenant = 0;
-    config.service.max_stored_mb_per_tenant = 0;
-    config.service.retention_days = 0.0;
-    std::error_code ignored;
-    const std::filesystem::path parent = std::filesystem::path(config.service.db_path).parent_path();
-    if (!parent.empty()) std::filesystem::create_directories(parent, ignored);
-    auto server = rpc::GrpcServer::start(config);
+    embedded::EmbeddedOptions embedded_options;
+    embedded_options.db_path = options.db.empty() ? embedded::default_database_path() : options.db;
+    embedded_options.run_jobs = options.run_jobs;
+    auto server = embedded::EmbeddedServer::start(embedded_options);
     if (!server && options.db.empty()) {
       // No writable data directory (a read-only home, a bare container): keep working, without history.
       std::fprintf(stderr, "balloon: warning: %s; using a temporary in-memory job store\n", server.error().c_str());
-      config.service.db_path = ":memory:";
-      server = rpc::GrpcServer::start(config);
+      embedded_options.db_path = ":memory:";
+      server = embedded::EmbeddedServer::start(embedded_options);
     }
     if (!server) return fail("cannot start the embedded server: " + server.error());
     connection->m_embedded = std::move(*server);
-    connection->m_channel = connection->m_embedded->in_process_channel();
-    connection->m_database = config.service.db_path;
+    connection->m_channel = connection->m_embedded->channel();
+    connection->m_database = embedded_options.db_path;
   }
   connection->m_stub = balloon::v1::BalloonService::NewStub(connection->m_channel);
   return connection;

@@ -11,8 +11,8 @@
 #include "balloon/v1/balloon.grpc.pb.h"
 #include "result.hpp"
 
-namespace balloon::rpc {
-class GrpcServer;
+namespace balloon::embedded {
+class EmbeddedServer;
 }
 
 namespace balloon::cli {
@@ -25,10 +25,6 @@ struct ConnectionOptions {
   bool tls = false;      ///< TLS with the system roots
   bool run_jobs = true;  ///< embedded server: start workers (commands that wait for jobs)
 };
-
-/// The embedded server's default database: $XDG_DATA_HOME/balloon/balloon.db, else
-/// ~/.local/share/balloon/balloon.db.
-std::string default_database_path();
 
 class ServiceConnection {
  public:
@@ -48,7 +44,7 @@ class ServiceConnection {
 
  private:
   ServiceConnection() = default;
-  std::unique_ptr<rpc::GrpcServer> m_embedded;
+  std::unique_ptr<embedded::EmbeddedServer> m_embedded;
   std::shared_ptr<grpc::Channel> m_channel;
   std::unique_ptr<balloon::v1::BalloonService::Stub> m_stub;
   std::string m_token;

@@ -14,13 +14,14 @@
 #include <sstream>
 
 #include "jobs/json_writer.hpp"
-#include "material/bulge_test.hpp"
+#include "calibration/bulge_simulation.hpp"
+#include "calibration/fem_bulge_fit.hpp"
 
 namespace balloon::jobs {
 namespace {
 
 /// Rings of the FEM disc used for bulge data: 817 vertices; pressures within about 0.5% of the
-/// axisymmetric solution (tests/core/material/test_bulge_test.cpp), a sweep in well under a second.
+/// axisymmetric solution (tests/core/calibration/test_bulge_simulation.cpp), a sweep in well under a second.
 constexpr int FIT_BULGE_RINGS = 16;
 
 double now_s() {

@@ -41,7 +41,7 @@ struct FitOutcome {
   double time_s = 0.0;  ///< wall time of all fits (s)
 };
 
-/// Fits every model. Bulge sets use the FEM bulge simulation (core/material/bulge_test) through
+/// Fits every model. Bulge sets use the FEM bulge simulation (core/calibration/bulge_simulation) through
 /// fit_material_with_fem_bulge (a spherical cap corrected by FEM sweeps at the current fit).
 /// Fails with a message when the data cannot be fitted (e.g. fewer points than parameters), or with
 /// FIT_CANCELLED once `cancel` (may be null) fires: it is checked between iterations of every fit.

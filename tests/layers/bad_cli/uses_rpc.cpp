@@ -1,0 +1,3 @@
+// Fixture: the CLI reaching into the service through the rpc layer.
+#include "rpc/grpc_server.hpp"
+#include "embedded/embedded_server.hpp"

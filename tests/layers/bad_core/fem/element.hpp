@@ -1,0 +1,3 @@
+#pragma once
+// Fixture: fem reaching up into solve.
+#include "solve/solver.hpp"

@@ -1,0 +1,3 @@
+#pragma once
+// Fixture: a core header that reaches gRPC.
+#include <grpcpp/grpcpp.h>
