@@ -4,7 +4,7 @@
 Usage: cli_layers_test.py CLI_DIR SERVER_DIR CORE_DIR PROTO_DIR
 
 Every "..." include of every file under CLI_DIR must name a file of CLI_DIR itself, of core/, of proto/
-(balloon::contract), a generated balloon/v1/*.pb.h, or one of the server/ folders the CLI links as targets
+(balloon::contract), a generated balloon/v1/*.pb.h or google/rpc/*.pb.h, or one of the server/ folders the CLI links as targets
 (ALLOWED_SERVER_FOLDERS: embedded/ is balloon::embedded, jobs/ is balloon::jobs). rpc/, service/, store/,
 http/, net/ fail, but for the files of ALLOWED_SERVER_FILES.
 Prints one line per violation and exits 1, or prints what it checked and exits 0.
@@ -38,7 +38,7 @@ def main() -> int:
             where = f"{path.relative_to(cli)}:{number}: #include \"{included}\""
             if any((root / included).is_file() for root in (path.parent, core, proto)):
                 continue
-            if included.startswith("balloon/v1/") and included.endswith(".pb.h"):
+            if included.startswith(("balloon/v1/", "google/rpc/")) and included.endswith(".pb.h"):
                 continue
             folder = included.split("/")[0]
             if (server / included).is_file() and (folder in ALLOWED_SERVER_FOLDERS or included in ALLOWED_SERVER_FILES):
