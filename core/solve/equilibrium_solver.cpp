@@ -216,11 +216,15 @@ NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressur
         const double merit0 = std::pow(report.residual_norm / force_tolerance, 2) + std::pow(c / volume_tolerance, 2);
         double t = 1.0;
         // Towards a saddle (a symmetric state past a bifurcation, as a sphere past its pressure
-        // maximum) only a full step is taken: Newton's own convergence shows the state is near.
-        const int halvings = m_last_unstable_modes == 0 ? 8 : 1;
+        // maximum) only from close by (residual below 1e-4 of the force scale) and only a full step
+        // that at least halves the residual: Newton's own quadratic convergence shows the saddle is
+        // near. Farther out the SQP step leaves it for a stable state.
+        const bool stable = m_last_unstable_modes == 0;
+        const bool near = report.residual_norm <= 1e-4 * force_tolerance / settings.relative_tolerance;
+        const int halvings = stable ? 8 : (near ? 1 : 0);
         for (int k = 0; k < halvings && !exact; ++k, t *= 0.5) {
           const Eigen::VectorXd trial = x + t * step;
-          if (merit(trial, pressure_mpa + t * dp, force_tolerance) <= (1.0 - 1e-4 * t) * merit0) {
+          if (merit(trial, pressure_mpa + t * dp, force_tolerance) <= (stable ? 1.0 - 1e-4 * t : 0.25) * merit0) {
             x = trial;
             pressure_mpa += t * dp;
             exact = true;
@@ -310,8 +314,9 @@ bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, doubl
   const double slope = (r - dp * v + kappa * c * v).dot(dx);
   const Eigen::VectorXd step = m_assembly.extend(dx);
   const double value = merit(x);
-  // Close to a solution the merit's change drowns in the round-off of W; a clear fall of the KKT
-  // residual (force and volume, each against its own scale) then decides.
+  // Close to a solution (residual below 1e-4 of the force scale) the merit's change drowns in the
+  // round-off of W; a clear fall of the KKT residual (force and volume, each against its own scale)
+  // then decides.
   auto kkt_residual = [&](const Eigen::VectorXd& y, double p) {
     const double force = m_assembly.restrict(residual(y, p)).norm();
     const double volume = (m_model.volume(y) - target_volume) * std::sqrt(kappa) * std::sqrt(base);
@@ -319,15 +324,16 @@ bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, doubl
     return std::isfinite(value) ? value : std::numeric_limits<double>::infinity();
   };
   const double kkt0 = std::hypot(r.norm(), c * std::sqrt(kappa) * std::sqrt(base));
+  const bool near = r.norm() <= 1e-4 * force_scale(x, pressure_mpa);
   double t = 1.0;
   for (int k = 0; k < 30; ++k, t *= 0.5) {
     const Eigen::VectorXd trial = x + t * step;
     const double trial_value = merit(trial);
     if ((std::isfinite(trial_value) && trial_value <= value + 1e-4 * t * std::min(0.0, slope)) ||
-        kkt_residual(trial, pressure_mpa + t * dp) < 0.5 * kkt0) {
+        (near && kkt_residual(trial, pressure_mpa + t * dp) < 0.5 * kkt0)) {
       x = trial;
       pressure_mpa = pressure_mpa + t * dp;
-      m_sqp_full_steps = shift == 0.0 ? m_sqp_full_steps + 1 : 0;
+      m_sqp_full_steps = (k == 0 && shift == 0.0) ? m_sqp_full_steps + 1 : 0;
       if (k > 2) m_sqp_shift = std::max(m_sqp_shift * 4.0, 1e-6 * base);
       return true;
     }
