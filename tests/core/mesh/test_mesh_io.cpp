@@ -679,6 +679,85 @@ TEST(MeshIoHostile, InputsThatAssimpMishandlesAreRefusedBeforeIt) {
   expect_contains(deep_nodes.error(), {"more than 4096 objects"});
 }
 
+std::string read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
+
+/// `json` with the first `from` replaced by `to` (which must be there: a fixture that changed fails here).
+std::string replaced(std::string json, const std::string& from, const std::string& to) {
+  const std::size_t at = json.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? json : json.replace(at, from.size(), to);
+}
+
+TEST(MeshIoHostile, GltfLayoutsThatAssimpTrustsAreChecked) {
+  // Found by tests/fuzz (seed 1, 2,209 runs): a byteStride taking the index accessor past its buffer view.
+  // assimp 5.2 checks an accessor's length without the stride, allocated the faces, then threw on the first
+  // index past the view and leaked them (27,656 bytes here, as large as the index count makes them).
+  const std::string found = read_bytes(std::string(BALLOON_FUZZ_REGRESSIONS_DIR) + "/glb-leak-60f7694b.glb");
+  ASSERT_EQ(found.size(), 31644u);
+  const auto refused = read_mesh_from_memory(found, "glb");
+  ASSERT_FALSE(refused.ok());
+  expect_contains(refused.error(), {"cannot read glb mesh data: bad glTF: buffer view 1: byteStride 10392"});
+
+  const TriMesh sphere = make_icosphere(2.0, 1);  // 42 vertices, 80 faces: 504 bytes of positions, 960 of indices
+  const std::string gltf = gltf_embedded(sphere, R"([{"mesh":0}])", 1);
+  ASSERT_TRUE(read_mesh_from_memory(gltf, "gltf").ok());
+  const auto check = [](const std::string& bytes, const char* format, std::initializer_list<std::string> fragments) {
+    const auto result = read_mesh_from_memory(bytes, format);
+    ASSERT_FALSE(result.ok());
+    expect_contains(result.error(), fragments);
+  };
+  // The same class within the stride range the specification allows.
+  check(replaced(gltf, R"("byteLength":960,)", R"("byteLength":960,"byteStride":8,)"), "gltf",
+        {"bad glTF: accessor 1 (240 elements of 4 bytes, 8 apart, from offset 0) does not fit in buffer view 1 (960 bytes)"});
+  check(replaced(gltf, R"("componentType":5125,"count":240)", R"("byteOffset":4,"componentType":5125,"count":240)"),
+        "gltf", {"accessor 1 (240 elements of 4 bytes, 4 apart, from offset 4) does not fit"});
+  check(replaced(gltf, R"("byteOffset":504,"byteLength":960)", R"("byteOffset":600,"byteLength":960)"), "gltf",
+        {"bad glTF: buffer view 1 (offset 600, length 960) ends past buffer 0 (1464 bytes)"});
+  // assimp underflowed "count - 2" faces for a strip of fewer than 3 indices; sparse indices without a view
+  // were dereferenced; a POSITION narrower than VEC3 float was read into 12-byte vectors.
+  check(replaced(replaced(gltf, R"("mode":4)", R"("mode":5)"), R"("componentType":5125,"count":240)",
+                 R"("componentType":5125,"count":2)"),
+        "gltf", {"mesh 0 primitive 0 has 2 indices, fewer than one primitive of mode 5 needs"});
+  check(replaced(gltf, R"("type":"SCALAR")", R"("type":"SCALAR","sparse":{"count":1,"indices":{"componentType":5125},"values":{"bufferView":0}})"),
+        "gltf", {"accessor 1 sparse indices has no 'bufferView'"});
+  check(replaced(gltf, R"("count":42,"type":"VEC3")", R"("count":42,"type":"VEC2")"), "gltf",
+        {"mesh 0 primitive 0 POSITION (accessor 0) must be VEC3 of componentType 5126, not VEC2 of 5126"});
+  check(replaced(gltf, R"("scene":0,)", R"("scene":0,"scene":1,)"), "gltf", {"the key 'scene' is repeated in one object"});
+  check(replaced(gltf, R"("scene":0,)", R"("scene":0,"skins":[{"joints":[0]}],)"), "gltf", {"skins are not supported"});
+  // A GLB's binary chunk shorter than the buffer the JSON declares on it.
+  const std::string binary = glb(sphere, R"([{"mesh":0}])", 1);
+  ASSERT_TRUE(read_mesh_from_memory(binary, "glb").ok());
+  std::string short_bin = binary.substr(0, binary.size() - 8);
+  const std::uint32_t json_length = static_cast<std::uint32_t>(static_cast<unsigned char>(binary[12])) |
+                                    static_cast<std::uint32_t>(static_cast<unsigned char>(binary[13])) << 8;
+  const std::uint32_t bin_length = 1464 - 8;
+  std::memcpy(short_bin.data() + 20 + json_length, &bin_length, 4);
+  check(short_bin, "glb", {"bad glTF: buffer 0 declares 1464 bytes but the GLB's binary chunk has 1456"});
+}
+
+TEST(MeshIoHostile, GltfWithStridedInterleavedDataIsRead) {
+  // The layout check must not refuse what the specification allows: positions 16 bytes apart (each followed
+  // by 4 bytes of padding), the view ending right after the last one's padding.
+  const TriMesh sphere = make_icosphere(2.0, 1);
+  std::string buffer;
+  const std::string packed = gltf_buffer(sphere);
+  for (int v = 0; v < sphere.vertex_count(); ++v) buffer += packed.substr(static_cast<std::size_t>(v) * 12, 12) + std::string(4, '\0');
+  buffer += packed.substr(504);
+  std::string gltf = gltf_embedded(sphere, R"([{"mesh":0}])", 1);
+  gltf = replaced(gltf, R"("byteLength":1464)", R"("byteLength":1632)");
+  gltf = replaced(gltf, R"("byteOffset":0,"byteLength":504)", R"("byteOffset":0,"byteLength":672,"byteStride":16)");
+  gltf = replaced(gltf, R"("byteOffset":504,"byteLength":960)", R"("byteOffset":672,"byteLength":960)");
+  gltf = replaced(gltf, base64(packed), base64(buffer));
+  const auto strided = read_mesh_from_memory(gltf, "gltf");
+  ASSERT_TRUE(strided.ok()) << strided.error();
+  EXPECT_TRUE(same_geometry(sphere, *strided, 1e-6));
+}
+
 TEST(MeshIoHostile, OnlyTheDeclaredFormatsImporterReadsTheBytes) {
   // assimp's ReadFile guesses another format when the declared one's importer declines: an OBJ sent as
   // STL or glTF was read by the OBJ importer. Now the declared importer alone reads it, and refuses it.
