@@ -351,8 +351,8 @@ class LayoutCheck {
         return problem;
       }
     }
-    // assimp 5.2 allocates count - 2 faces for a strip or fan and reads the first primitive's indices
-    // before the loop: fewer than one primitive's worth underflowed the count.
+    // Fewer indices (or vertices) than one primitive of the mode: assimp 5.2 reads the first primitive's
+    // indices before its loop over the rest, so the count is checked here rather than trusted.
     const std::uint64_t count = m_accessors[indexed ? indices : position].count;
     static constexpr std::uint64_t MINIMUM[] = {1, 2, 2, 2, 3, 3, 3};  // points, lines, loop, strip, triangles, strip, fan
     if (count < MINIMUM[mode]) {
