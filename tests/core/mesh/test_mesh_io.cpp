@@ -729,6 +729,9 @@ TEST(MeshIoHostile, GltfLayoutsThatAssimpTrustsAreChecked) {
         {"mesh 0 primitive 0 POSITION (accessor 0) must be VEC3 of componentType 5126, not VEC2 of 5126"});
   check(replaced(gltf, R"("scene":0,)", R"("scene":0,"scene":1,)"), "gltf", {"the key 'scene' is repeated in one object"});
   check(replaced(gltf, R"("scene":0,)", R"("scene":0,"skins":[{"joints":[0]}],)"), "gltf", {"skins are not supported"});
+  // A data: URI with bad base64 leaked its decoded buffer in assimp; the raw scan misses an escaped "uri" key.
+  check(replaced(gltf, R"("uri":"data:application/octet-stream;base64,)", R"("\u0075ri":"data:application/octet-stream;base64,*)"),
+        "gltf", {"bad glTF: buffer 0: a data: URI that is not strict base64"});
   // A GLB's binary chunk shorter than the buffer the JSON declares on it.
   const std::string binary = glb(sphere, R"([{"mesh":0}])", 1);
   ASSERT_TRUE(read_mesh_from_memory(binary, "glb").ok());
