@@ -274,6 +274,7 @@ struct PlyProperty {
   std::string_view value_type;
 };
 struct PlyElement {
+  std::string_view name;
   std::uint64_t count = 0;
   std::vector<PlyProperty> properties;
 };
@@ -331,13 +332,56 @@ std::string check_ascii_ply_body(std::string_view text, const std::vector<PlyEle
   return {};
 }
 
+/// Bytes of one value of PLY scalar `type`.
+std::uint64_t ply_type_size(std::string_view type) {
+  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+  if (type == "double" || type == "float64") return 8;
+  return 4;  // int, uint, float and their sized names
+}
+
+/// "" or why a binary PLY body does not hold the elements its header declares: each list's length (of an
+/// integer type, `big_endian` or not) must be non-negative and its values, like every scalar, within the
+/// bytes. assimp 5.2 sized a list from a negative length read as unsigned (a 30 kB file asked for 32 GB),
+/// and leaked the mesh built so far when a list ran past the end. Every property takes at least one byte,
+/// so the walk is linear in the body.
+std::string check_binary_ply_body(std::string_view body, const std::vector<PlyElement>& elements, bool big_endian) {
+  std::uint64_t at = 0;
+  for (const PlyElement& element : elements) {
+    if (element.properties.empty()) continue;  // only with count 0 (checked with the header)
+    for (std::uint64_t instance = 0; instance < element.count; ++instance) {
+      const auto where = [&] { return "bad PLY data: " + std::string(element.name) + " " + std::to_string(instance) + ": "; };
+      for (const PlyProperty& property : element.properties) {
+        std::uint64_t values = 1;
+        if (property.list) {
+          const std::uint64_t size = ply_type_size(property.count_type);
+          if (size > body.size() - at) return where() + "the data ends before the header's elements do";
+          std::uint64_t raw = 0;
+          for (std::uint64_t k = 0; k < size; ++k) {
+            const auto byte = static_cast<unsigned char>(body[static_cast<std::size_t>(at + (big_endian ? k : size - 1 - k))]);
+            raw = (raw << 8) | byte;
+          }
+          at += size;
+          const bool is_signed = property.count_type.front() != 'u';
+          if (is_signed && (raw >> (8 * size - 1)) != 0) return where() + "a negative list length";
+          values = raw;
+        }
+        const std::uint64_t bytes = values * ply_type_size(property.value_type);  // values < 2^32: no overflow
+        if (bytes > body.size() - at) return where() + "the data ends before the header's elements do";
+        at += bytes;
+      }
+    }
+  }
+  return {};
+}
+
 /// "" or why a PLY header is malformed, or declares counts that the bytes cannot hold or that are over the
 /// limits. The grammar is checked line by line here because assimp 5.2's PLY parser loops for ever on
 /// some malformed headers (an element without a name, a property line cut short): see tests/fuzz/README.md.
 std::string check_ply_header(std::string_view bytes, const MeshReadLimits& limits) {
   std::size_t at = 0;
   int line_number = 0;
-  bool have_format = false, have_end = false, ascii = false;
+  bool have_format = false, have_end = false, ascii = false, big_endian = false;
   std::uint64_t vertex_count = 0, face_count = 0;
   std::vector<PlyElement> elements;
   while (at < bytes.size() && !have_end) {
@@ -361,6 +405,7 @@ std::string check_ply_header(std::string_view bytes, const MeshReadLimits& limit
       }
       have_format = true;
       ascii = words[1] == "ascii";
+      big_endian = words[1] == "binary_big_endian";
     } else if (words[0] == "element") {
       std::uint64_t count = 0;
       if (words.size() != 3 || !is_ply_name(words[1]) || !parse_count(words[2], count)) {
@@ -368,12 +413,19 @@ std::string check_ply_header(std::string_view bytes, const MeshReadLimits& limit
       }
       if (words[1] == "vertex") vertex_count = count;
       if (words[1] == "face") face_count = count;
-      elements.push_back(PlyElement{count, {}});
+      if (!elements.empty() && elements.back().count > 0 && elements.back().properties.empty()) {
+        return where + "element '" + std::string(elements.back().name) + "' has no properties";
+      }
+      elements.push_back(PlyElement{words[1], count, {}});
     } else if (words[0] == "property") {
       const bool list = words.size() == 5 && words[1] == "list" && is_ply_scalar_type(words[2]) &&
                         is_ply_scalar_type(words[3]) && is_ply_name(words[4]);
       const bool scalar = words.size() == 3 && is_ply_scalar_type(words[1]) && is_ply_name(words[2]);
       if (!list && !scalar) return where + "expected 'property TYPE NAME' or 'property list TYPE TYPE NAME'";
+      // assimp 5.2 reads a float length as any number (a huge one leaked the mesh built so far).
+      if (list && !is_ply_integer_type(words[2])) {
+        return where + "a list's length type must be an integer type, not " + quoted(words[2]);
+      }
       if (elements.empty()) return where + "a property before any element";
       elements.back().properties.push_back(list ? PlyProperty{true, words[2], words[3]} : PlyProperty{false, {}, words[1]});
     } else if (words[0] == "end_header" && words.size() == 1) {
@@ -381,6 +433,9 @@ std::string check_ply_header(std::string_view bytes, const MeshReadLimits& limit
     } else {
       return where + "unknown keyword " + quoted(words[0].substr(0, 40));
     }
+  }
+  if (!elements.empty() && elements.back().count > 0 && elements.back().properties.empty()) {
+    return "bad PLY header: element '" + std::string(elements.back().name) + "' has no properties";
   }
   if (!have_end) return "bad PLY header: no end_header line";
   if (!have_format) return "bad PLY header: no format line";
@@ -397,7 +452,7 @@ std::string check_ply_header(std::string_view bytes, const MeshReadLimits& limit
     if (!over.empty()) return over;
   }
   if (ascii) return check_ascii_ply_body(bytes.substr(std::min(at, bytes.size())), elements, line_number + 1);
-  return {};
+  return check_binary_ply_body(bytes.substr(std::min(at, bytes.size())), elements, big_endian);
 }
 
 /// "" or why an STL has more triangles than allowed; binary STL declares its count at byte 80. (Its

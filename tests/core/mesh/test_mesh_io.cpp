@@ -761,6 +761,41 @@ TEST(MeshIoHostile, GltfWithStridedInterleavedDataIsRead) {
   EXPECT_TRUE(same_geometry(sphere, *strided, 1e-6));
 }
 
+TEST(MeshIoHostile, BinaryPlyListsAreCheckedBeforeAssimp) {
+  // Found by tests/fuzz (fuzz_mesh_ply, 10-minute run, execution 24,921): a float list length. assimp 5.2
+  // read it as a huge count, ran past the end and leaked the mesh it had built (29,973 bytes).
+  const std::string found = read_bytes(std::string(BALLOON_FUZZ_REGRESSIONS_DIR) + "/ply-leak-200100cb.ply");
+  ASSERT_EQ(found.size(), 27271u);
+  const auto refused = read_mesh_from_memory(found, "ply");
+  ASSERT_FALSE(refused.ok());
+  expect_contains(refused.error(), {"bad PLY header: line 9: a list's length type must be an integer type, not 'float'"});
+
+  const TriMesh sphere = make_icosphere(1.0, 1);  // 42 vertices of 3 doubles, 80 faces of 1 + 3 x 4 bytes
+  const std::string binary = write_mesh_to_memory(sphere, "ply");
+  ASSERT_TRUE(read_mesh_from_memory(binary, "ply").ok());
+  const std::size_t body = binary.find("end_header\n") + 11;
+  ASSERT_EQ(binary.size() - body, 42u * 24 + 80u * 13);
+  // A signed length of -1: assimp 5.2 sized the list from it as unsigned (32 GB for a 30 kB file).
+  std::string negative = replaced(binary, "property list uchar int", "property list char  int");
+  negative[body + 42 * 24 + 13 * 5] = '\xff';
+  const auto negative_result = read_mesh_from_memory(negative, "ply");
+  ASSERT_FALSE(negative_result.ok());
+  expect_contains(negative_result.error(), {"bad PLY data: face 5: a negative list length"});
+  // A list running past the end, and a body cut short.
+  std::string long_list = binary;
+  long_list[body + 42 * 24 + 13 * 79] = '\x04';
+  const auto long_result = read_mesh_from_memory(long_list, "ply");
+  ASSERT_FALSE(long_result.ok());
+  expect_contains(long_result.error(), {"bad PLY data: face 79: the data ends before the header's elements do"});
+  const auto cut = read_mesh_from_memory(binary.substr(0, binary.size() - 5), "ply");
+  ASSERT_FALSE(cut.ok());
+  expect_contains(cut.error(), {"bad PLY data: face 79: the data ends"});
+  // An element without properties would make assimp loop over its count reading nothing.
+  const auto empty = read_mesh_from_memory(replaced(binary, "element face", "element junk 1000000000\nelement face"), "ply");
+  ASSERT_FALSE(empty.ok());
+  expect_contains(empty.error(), {"element 'junk' has no properties"});
+}
+
 TEST(MeshIoHostile, OnlyTheDeclaredFormatsImporterReadsTheBytes) {
   // assimp's ReadFile guesses another format when the declared one's importer declines: an OBJ sent as
   // STL or glTF was read by the OBJ importer. Now the declared importer alone reads it, and refuses it.
