@@ -729,6 +729,8 @@ TEST(MeshIoHostile, GltfLayoutsThatAssimpTrustsAreChecked) {
         {"mesh 0 primitive 0 POSITION (accessor 0) must be VEC3 of componentType 5126, not VEC2 of 5126"});
   check(replaced(gltf, R"("scene":0,)", R"("scene":0,"scene":1,)"), "gltf", {"the key 'scene' is repeated in one object"});
   check(replaced(gltf, R"("scene":0,)", R"("scene":0,"skins":[{"joints":[0]}],)"), "gltf", {"skins are not supported"});
+  check(replaced(gltf, R"("mode":4)", R"("mode":4,"extensions":{"KHR_draco_mesh_compression":{"bufferView":0,"attributes":{"POSITION":0}}})"),
+        "gltf", {"bad glTF: Draco-compressed meshes (KHR_draco_mesh_compression) are not supported"});
   // A data: URI with bad base64 leaked its decoded buffer in assimp; the raw scan misses an escaped "uri" key.
   check(replaced(gltf, R"("uri":"data:application/octet-stream;base64,)", R"("\u0075ri":"data:application/octet-stream;base64,*)"),
         "gltf", {"bad glTF: buffer 0: a data: URI that is not strict base64"});
