@@ -531,6 +531,13 @@ TEST(MeshIo, OverwritesAnExistingFile) {
 // ------------------------------------------------------------------------------------------------
 // Hostile uploads (issue 11): the reader reads the uploaded bytes and nothing else, and bounds its work.
 
+std::string read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
+
 TEST(MeshIoHostile, GltfNamingAServerFileIsRefusedWithoutReadingIt) {
   // The buffer lies beside us as a valid one: before the fix, assimp read it and returned the mesh.
   const TriMesh original = make_icosphere(2.0, 1);
@@ -640,6 +647,14 @@ TEST(MeshIoHostile, InputsThatAssimpMishandlesAreRefusedBeforeIt) {
   ASSERT_FALSE(ply.ok());
   expect_contains(ply.error(), {"bad PLY data: line 12", "'x0' is not a float"});
   ASSERT_TRUE(read_mesh_from_memory(ply_header + "0 0 0\n1 0 0\n0 1 -1e-3\n3 0 1 2\n", "ply").ok());
+  // Found by the 10-minute fuzz_mesh_ply run (tests/fuzz/regressions/ply-leak-8be8d00b.ply): two signs.
+  const auto two_signs = read_mesh_from_memory(ply_header + "0 0 0\n1 0 0\n0 +-1 1\n3 0 1 2\n", "ply");
+  ASSERT_FALSE(two_signs.ok());
+  expect_contains(two_signs.error(), {"bad PLY data: line 12", "'+-1' is not a float"});
+  const auto found = read_mesh_from_memory(read_bytes(std::string(BALLOON_FUZZ_REGRESSIONS_DIR) + "/ply-leak-8be8d00b.ply"), "ply");
+  ASSERT_FALSE(found.ok());
+  expect_contains(found.error(), {"bad PLY data: line 519", "'+-1' is not a float"});
+  ASSERT_TRUE(read_mesh_from_memory(ply_header + "0 0 0\n1 0 0\n0 +1 1\n3 0 1 2\n", "ply").ok());
   // Lines out of step with the header: assimp read a coordinate as a face's list length, and leaked.
   const auto short_line = read_mesh_from_memory(ply_header + "0 0 0\n1 0\n0 1 0\n3 0 1 2\n", "ply");
   ASSERT_FALSE(short_line.ok());
@@ -677,13 +692,6 @@ TEST(MeshIoHostile, InputsThatAssimpMishandlesAreRefusedBeforeIt) {
   const auto deep_nodes = read_mesh_from_memory(chain, "gltf");
   ASSERT_FALSE(deep_nodes.ok());
   expect_contains(deep_nodes.error(), {"more than 4096 objects"});
-}
-
-std::string read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  return bytes.str();
 }
 
 /// `json` with the first `from` replaced by `to` (which must be there: a fixture that changed fails here).
