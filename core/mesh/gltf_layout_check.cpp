@@ -400,6 +400,14 @@ class LayoutCheck {
     }
     if (mode > 6) return "bad glTF: " + where + ": mode " + std::to_string(mode) + " is not from 0 to 6";
     const bool indexed = primitive.contains("indices");
+    // assimp 5.2 builds each face of an indexed line loop, line strip or triangle fan from the face before
+    // it, and a face it skipped (an index past the vertices) has no indices: a null dereference (SEGV,
+    // found by fuzz_mesh_glb). Triangles, strips, lines and points skip such faces safely.
+    if (indexed && (mode == 2 || mode == 3 || mode == 6)) {
+      static constexpr const char* NAMES[] = {"", "", "LINE_LOOP", "LINE_STRIP", "", "", "TRIANGLE_FAN"};
+      return "bad glTF: " + where + ": indexed " + NAMES[mode] + " primitives (mode " + std::to_string(mode) +
+             ") are not supported; use TRIANGLES";
+    }
     if (indexed) {
       if (std::string problem = check_use(m_accessors, indices, where + " indices", {"SCALAR"}, {5121, 5123, 5125});
           !problem.empty()) {

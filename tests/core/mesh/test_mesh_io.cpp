@@ -733,6 +733,12 @@ TEST(MeshIoHostile, GltfLayoutsThatAssimpTrustsAreChecked) {
         "gltf", {"mesh 0 primitive 0 has 2 indices, fewer than one primitive of mode 5 needs"});
   check(replaced(gltf, R"("type":"SCALAR")", R"("type":"SCALAR","sparse":{"count":1,"indices":{"componentType":5125},"values":{"bufferView":0}})"),
         "gltf", {"accessor 1 sparse indices has no 'bufferView'"});
+  // An indexed line loop with an index past the vertices: assimp 5.2 dereferenced the skipped face (SEGV;
+  // tests/fuzz/regressions/glb-segv-24ad948d.glb, found by fuzz_mesh_glb).
+  const std::string segv = read_bytes(std::string(BALLOON_FUZZ_REGRESSIONS_DIR) + "/glb-segv-24ad948d.glb");
+  ASSERT_EQ(segv.size(), 1479u);
+  check(segv, "glb", {"bad glTF: mesh 0 primitive 0: indexed LINE_LOOP primitives (mode 2) are not supported"});
+  check(replaced(gltf, R"("mode":4)", R"("mode":6)"), "gltf", {"indexed TRIANGLE_FAN primitives (mode 6) are not supported"});
   check(replaced(gltf, R"("count":42,"type":"VEC3")", R"("count":42,"type":"VEC2")"), "gltf",
         {"mesh 0 primitive 0 POSITION (accessor 0) must be VEC3 of componentType 5126, not VEC2 of 5126"});
   check(replaced(gltf, R"("scene":0,)", R"("scene":0,"scene":1,)"), "gltf", {"the key 'scene' is repeated in one object"});
