@@ -12,8 +12,8 @@ PACKAGES=(
   clang libclang-rt-14-dev
   # numerics: Eigen, CHOLMOD (SuiteSparse) with OpenBLAS behind it, nanoflann (kd-tree), CGAL (remeshing, AABB)
   libeigen3-dev libsuitesparse-dev libopenblas0-pthread libnanoflann-dev libcgal-dev
-  # mesh files
-  libassimp-dev
+  # mesh files (nlohmann-json: the glTF layout check before assimp reads an upload)
+  libassimp-dev nlohmann-json3-dev
   # service: gRPC, protobuf, SQLite, HTTP gateway
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler libsqlite3-dev libcpp-httplib-dev
   # HTTPS for the gateway (--http-tls-cert): Debian's cpp-httplib is built with CPPHTTPLIB_OPENSSL_SUPPORT

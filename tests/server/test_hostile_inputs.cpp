@@ -355,6 +355,14 @@ TEST(HostileInputs, CatalogueGetsItsStatusesAndTheServerStaysServingAndSmall) {
             v1::MESH_FORMAT_PLY, StatusCode::INVALID_ARGUMENT, "'x0' is not a float");
   mesh_case("glTF with bad base64", gltf_with_uri("data:application/octet-stream;base64,AA*A"), v1::MESH_FORMAT_GLTF,
             StatusCode::INVALID_ARGUMENT, "bad base64");
+  {
+    // Found by tests/fuzz: a byteStride taking the index accessor past its view; assimp leaked the faces it had allocated.
+    std::string strided = gltf_with_uri("data:application/octet-stream;base64," + std::string(128, 'A'));
+    const std::string view = R"("byteOffset":48,"byteLength":48})";
+    strided.replace(strided.find(view), view.size(), R"("byteOffset":48,"byteLength":48,"byteStride":8})");
+    mesh_case("glTF index accessor strided past its buffer view (assimp leaked)", strided, v1::MESH_FORMAT_GLTF,
+              StatusCode::INVALID_ARGUMENT, "accessor 1 (12 elements of 4 bytes, 8 apart, from offset 0) does not fit in buffer view 1");
+  }
 
   // Non-finite coordinates: refused before the weld, in time linear in the file.
   for (const std::uint32_t triangles : {5000u, 20000u, 80000u}) {

@@ -531,6 +531,13 @@ TEST(MeshIo, OverwritesAnExistingFile) {
 // ------------------------------------------------------------------------------------------------
 // Hostile uploads (issue 11): the reader reads the uploaded bytes and nothing else, and bounds its work.
 
+std::string read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
+
 TEST(MeshIoHostile, GltfNamingAServerFileIsRefusedWithoutReadingIt) {
   // The buffer lies beside us as a valid one: before the fix, assimp read it and returned the mesh.
   const TriMesh original = make_icosphere(2.0, 1);
@@ -640,6 +647,14 @@ TEST(MeshIoHostile, InputsThatAssimpMishandlesAreRefusedBeforeIt) {
   ASSERT_FALSE(ply.ok());
   expect_contains(ply.error(), {"bad PLY data: line 12", "'x0' is not a float"});
   ASSERT_TRUE(read_mesh_from_memory(ply_header + "0 0 0\n1 0 0\n0 1 -1e-3\n3 0 1 2\n", "ply").ok());
+  // Found by the 10-minute fuzz_mesh_ply run (tests/fuzz/regressions/ply-leak-8be8d00b.ply): two signs.
+  const auto two_signs = read_mesh_from_memory(ply_header + "0 0 0\n1 0 0\n0 +-1 1\n3 0 1 2\n", "ply");
+  ASSERT_FALSE(two_signs.ok());
+  expect_contains(two_signs.error(), {"bad PLY data: line 12", "'+-1' is not a float"});
+  const auto found = read_mesh_from_memory(read_bytes(std::string(BALLOON_FUZZ_REGRESSIONS_DIR) + "/ply-leak-8be8d00b.ply"), "ply");
+  ASSERT_FALSE(found.ok());
+  expect_contains(found.error(), {"bad PLY data: line 519", "'+-1' is not a float"});
+  ASSERT_TRUE(read_mesh_from_memory(ply_header + "0 0 0\n1 0 0\n0 +1 1\n3 0 1 2\n", "ply").ok());
   // Lines out of step with the header: assimp read a coordinate as a face's list length, and leaked.
   const auto short_line = read_mesh_from_memory(ply_header + "0 0 0\n1 0\n0 1 0\n3 0 1 2\n", "ply");
   ASSERT_FALSE(short_line.ok());
@@ -677,6 +692,124 @@ TEST(MeshIoHostile, InputsThatAssimpMishandlesAreRefusedBeforeIt) {
   const auto deep_nodes = read_mesh_from_memory(chain, "gltf");
   ASSERT_FALSE(deep_nodes.ok());
   expect_contains(deep_nodes.error(), {"more than 4096 objects"});
+}
+
+/// `json` with the first `from` replaced by `to` (which must be there: a fixture that changed fails here).
+std::string replaced(std::string json, const std::string& from, const std::string& to) {
+  const std::size_t at = json.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? json : json.replace(at, from.size(), to);
+}
+
+TEST(MeshIoHostile, GltfLayoutsThatAssimpTrustsAreChecked) {
+  // Found by tests/fuzz (seed 1, 2,209 runs): a byteStride taking the index accessor past its buffer view.
+  // assimp 5.2 checks an accessor's length without the stride, allocated the faces, then threw on the first
+  // index past the view and leaked them (27,656 bytes here, as large as the index count makes them).
+  const std::string found = read_bytes(std::string(BALLOON_FUZZ_REGRESSIONS_DIR) + "/glb-leak-60f7694b.glb");
+  ASSERT_EQ(found.size(), 31644u);
+  const auto refused = read_mesh_from_memory(found, "glb");
+  ASSERT_FALSE(refused.ok());
+  expect_contains(refused.error(), {"cannot read glb mesh data: bad glTF: buffer view 1: byteStride 10392"});
+
+  const TriMesh sphere = make_icosphere(2.0, 1);  // 42 vertices, 80 faces: 504 bytes of positions, 960 of indices
+  const std::string gltf = gltf_embedded(sphere, R"([{"mesh":0}])", 1);
+  ASSERT_TRUE(read_mesh_from_memory(gltf, "gltf").ok());
+  const auto check = [](const std::string& bytes, const char* format, std::initializer_list<std::string> fragments) {
+    const auto result = read_mesh_from_memory(bytes, format);
+    ASSERT_FALSE(result.ok());
+    expect_contains(result.error(), fragments);
+  };
+  // The same class within the stride range the specification allows.
+  check(replaced(gltf, R"("byteLength":960,)", R"("byteLength":960,"byteStride":8,)"), "gltf",
+        {"bad glTF: accessor 1 (240 elements of 4 bytes, 8 apart, from offset 0) does not fit in buffer view 1 (960 bytes)"});
+  check(replaced(gltf, R"("componentType":5125,"count":240)", R"("byteOffset":4,"componentType":5125,"count":240)"),
+        "gltf", {"accessor 1 (240 elements of 4 bytes, 4 apart, from offset 4) does not fit"});
+  check(replaced(gltf, R"("byteOffset":504,"byteLength":960)", R"("byteOffset":600,"byteLength":960)"), "gltf",
+        {"bad glTF: buffer view 1 (offset 600, length 960) ends past buffer 0 (1464 bytes)"});
+  // A strip of fewer than 3 indices; sparse indices without a view (assimp 5.2 dereferences the missing view:
+  // SEGV); a POSITION that is not VEC3 float (assimp reads it as if it were).
+  check(replaced(replaced(gltf, R"("mode":4)", R"("mode":5)"), R"("componentType":5125,"count":240)",
+                 R"("componentType":5125,"count":2)"),
+        "gltf", {"mesh 0 primitive 0 has 2 indices, fewer than one primitive of mode 5 needs"});
+  check(replaced(gltf, R"("type":"SCALAR")", R"("type":"SCALAR","sparse":{"count":1,"indices":{"componentType":5125},"values":{"bufferView":0}})"),
+        "gltf", {"accessor 1 sparse indices has no 'bufferView'"});
+  // An indexed line loop with an index past the vertices: assimp 5.2 dereferenced the skipped face (SEGV;
+  // tests/fuzz/regressions/glb-segv-24ad948d.glb, found by fuzz_mesh_glb).
+  const std::string segv = read_bytes(std::string(BALLOON_FUZZ_REGRESSIONS_DIR) + "/glb-segv-24ad948d.glb");
+  ASSERT_EQ(segv.size(), 1479u);
+  check(segv, "glb", {"bad glTF: mesh 0 primitive 0: indexed LINE_LOOP primitives (mode 2) are not supported"});
+  check(replaced(gltf, R"("mode":4)", R"("mode":6)"), "gltf", {"indexed TRIANGLE_FAN primitives (mode 6) are not supported"});
+  check(replaced(gltf, R"("count":42,"type":"VEC3")", R"("count":42,"type":"VEC2")"), "gltf",
+        {"mesh 0 primitive 0 POSITION (accessor 0) must be VEC3 of componentType 5126, not VEC2 of 5126"});
+  check(replaced(gltf, R"("scene":0,)", R"("scene":0,"scene":1,)"), "gltf", {"the key 'scene' is repeated in one object"});
+  check(replaced(gltf, R"("scene":0,)", R"("scene":0,"skins":[{"joints":[0]}],)"), "gltf", {"skins are not supported"});
+  check(replaced(gltf, R"("mode":4)", R"("mode":4,"extensions":{"KHR_draco_mesh_compression":{"bufferView":0,"attributes":{"POSITION":0}}})"),
+        "gltf", {"bad glTF: Draco-compressed meshes (KHR_draco_mesh_compression) are not supported"});
+  // A data: URI with bad base64 leaked its decoded buffer in assimp; the raw scan misses an escaped "uri" key.
+  check(replaced(gltf, R"("uri":"data:application/octet-stream;base64,)", R"("\u0075ri":"data:application/octet-stream;base64,*)"),
+        "gltf", {"bad glTF: buffer 0: a data: URI that is not strict base64"});
+  // A GLB's binary chunk shorter than the buffer the JSON declares on it.
+  const std::string binary = glb(sphere, R"([{"mesh":0}])", 1);
+  ASSERT_TRUE(read_mesh_from_memory(binary, "glb").ok());
+  std::string short_bin = binary.substr(0, binary.size() - 8);
+  const std::uint32_t json_length = static_cast<std::uint32_t>(static_cast<unsigned char>(binary[12])) |
+                                    static_cast<std::uint32_t>(static_cast<unsigned char>(binary[13])) << 8;
+  const std::uint32_t bin_length = 1464 - 8;
+  std::memcpy(short_bin.data() + 20 + json_length, &bin_length, 4);
+  check(short_bin, "glb", {"bad glTF: buffer 0 declares 1464 bytes but the GLB's binary chunk has 1456"});
+}
+
+TEST(MeshIoHostile, GltfWithStridedInterleavedDataIsRead) {
+  // The layout check must not refuse what the specification allows: positions 16 bytes apart (each followed
+  // by 4 bytes of padding), the view ending right after the last one's padding.
+  const TriMesh sphere = make_icosphere(2.0, 1);
+  std::string buffer;
+  const std::string packed = gltf_buffer(sphere);
+  for (int v = 0; v < sphere.vertex_count(); ++v) buffer += packed.substr(static_cast<std::size_t>(v) * 12, 12) + std::string(4, '\0');
+  buffer += packed.substr(504);
+  std::string gltf = gltf_embedded(sphere, R"([{"mesh":0}])", 1);
+  gltf = replaced(gltf, R"("byteLength":1464)", R"("byteLength":1632)");
+  gltf = replaced(gltf, R"("byteOffset":0,"byteLength":504)", R"("byteOffset":0,"byteLength":672,"byteStride":16)");
+  gltf = replaced(gltf, R"("byteOffset":504,"byteLength":960)", R"("byteOffset":672,"byteLength":960)");
+  gltf = replaced(gltf, base64(packed), base64(buffer));
+  const auto strided = read_mesh_from_memory(gltf, "gltf");
+  ASSERT_TRUE(strided.ok()) << strided.error();
+  EXPECT_TRUE(same_geometry(sphere, *strided, 1e-6));
+}
+
+TEST(MeshIoHostile, BinaryPlyListsAreCheckedBeforeAssimp) {
+  // Found by tests/fuzz (fuzz_mesh_ply, 10-minute run, execution 24,921): a float list length. assimp 5.2
+  // read it as a huge count, ran past the end and leaked the mesh it had built (29,973 bytes).
+  const std::string found = read_bytes(std::string(BALLOON_FUZZ_REGRESSIONS_DIR) + "/ply-leak-200100cb.ply");
+  ASSERT_EQ(found.size(), 27271u);
+  const auto refused = read_mesh_from_memory(found, "ply");
+  ASSERT_FALSE(refused.ok());
+  expect_contains(refused.error(), {"bad PLY header: line 9: a list's length type must be an integer type, not 'float'"});
+
+  const TriMesh sphere = make_icosphere(1.0, 1);  // 42 vertices of 3 doubles, 80 faces of 1 + 3 x 4 bytes
+  const std::string binary = write_mesh_to_memory(sphere, "ply");
+  ASSERT_TRUE(read_mesh_from_memory(binary, "ply").ok());
+  const std::size_t body = binary.find("end_header\n") + 11;
+  ASSERT_EQ(binary.size() - body, 42u * 24 + 80u * 13);
+  // A signed length of -1: assimp 5.2 sized the list from it as unsigned (32 GB for a 30 kB file).
+  std::string negative = replaced(binary, "property list uchar int", "property list char  int");
+  negative[body + 42 * 24 + 13 * 5] = '\xff';
+  const auto negative_result = read_mesh_from_memory(negative, "ply");
+  ASSERT_FALSE(negative_result.ok());
+  expect_contains(negative_result.error(), {"bad PLY data: face 5: a negative list length"});
+  // A list running past the end, and a body cut short.
+  std::string long_list = binary;
+  long_list[body + 42 * 24 + 13 * 79] = '\x04';
+  const auto long_result = read_mesh_from_memory(long_list, "ply");
+  ASSERT_FALSE(long_result.ok());
+  expect_contains(long_result.error(), {"bad PLY data: face 79: the data ends before the header's elements do"});
+  const auto cut = read_mesh_from_memory(binary.substr(0, binary.size() - 5), "ply");
+  ASSERT_FALSE(cut.ok());
+  expect_contains(cut.error(), {"bad PLY data: face 79: the data ends"});
+  // An element without properties would make assimp loop over its count reading nothing.
+  const auto empty = read_mesh_from_memory(replaced(binary, "element face", "element junk 1000000000\nelement face"), "ply");
+  ASSERT_FALSE(empty.ok());
+  expect_contains(empty.error(), {"element 'junk' has no properties"});
 }
 
 TEST(MeshIoHostile, OnlyTheDeclaredFormatsImporterReadsTheBytes) {
