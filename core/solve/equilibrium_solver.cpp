@@ -196,13 +196,13 @@ NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressur
 
     // Fast path: exact Newton on the KKT system; globalised on the residual norm, for which it is a
     // descent direction. Tried at the start, after an exact step, and once the SQP steps below are
-    // full and unshifted (close to a solution), so far from one no factorization is spent on it.
+    // unshifted (close to a solution), so far from one no factorization is spent on it.
     bool exact = false;
     static const bool debug = std::getenv("BALLOON_DEBUG_NEWTON") != nullptr;
     if (debug)
       std::fprintf(stderr, "vol it %d r=%.3g tol=%.3g c=%.3g p=%.5g shift=%.3g\n", report.iterations,
                    report.residual_norm, force_tolerance, c, pressure_mpa, m_sqp_shift);
-    const bool exact_worth_trying = report.iterations == 0 || m_last_step_exact || m_sqp_full_steps > 0;
+    const bool exact_worth_trying = report.iterations == 0 || m_last_step_exact || m_sqp_unshifted_steps > 0;
     m_last_step_exact = false;
     const bool exact_factorized =
         exact_worth_trying && m_exact_fails_left == 0 && factorize_exact_for_volume(x, pressure_mpa, v);
@@ -216,15 +216,12 @@ NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressur
         const double merit0 = std::pow(report.residual_norm / force_tolerance, 2) + std::pow(c / volume_tolerance, 2);
         double t = 1.0;
         // Towards a saddle (a symmetric state past a bifurcation, as a sphere past its pressure
-        // maximum) only from close by (residual below 1e-4 of the force scale) and only a full step
-        // that at least halves the residual: Newton's own quadratic convergence shows the saddle is
-        // near. Farther out the SQP step leaves it for a stable state.
-        const bool stable = m_last_unstable_modes == 0;
-        const bool near = report.residual_norm <= 1e-4 * force_tolerance / settings.relative_tolerance;
-        const int halvings = stable ? 8 : (near ? 1 : 0);
+        // maximum) only a full step is taken: Newton's own convergence shows the saddle is near;
+        // otherwise the SQP step below leaves it for a stable state.
+        const int halvings = m_last_unstable_modes == 0 ? 8 : 1;
         for (int k = 0; k < halvings && !exact; ++k, t *= 0.5) {
           const Eigen::VectorXd trial = x + t * step;
-          if (merit(trial, pressure_mpa + t * dp, force_tolerance) <= (stable ? 1.0 - 1e-4 * t : 0.25) * merit0) {
+          if (merit(trial, pressure_mpa + t * dp, force_tolerance) <= (1.0 - 1e-4 * t) * merit0) {
             x = trial;
             pressure_mpa += t * dp;
             exact = true;
@@ -262,7 +259,7 @@ bool EquilibriumSolver::factorize_exact_for_volume(const Eigen::VectorXd& x, dou
     return false;
   }
   // The simplicial LDL^T costs several supernodal LL^T: only worth it close to a solution.
-  if (m_sqp_full_steps == 0) return false;
+  if (m_sqp_unshifted_steps == 0) return false;
   if (m_solver.factorize_ldlt(m_assembly.values()) != SparseSolver::Status::Ok) {
     m_skip_ldlt = 2;
     return false;
@@ -314,9 +311,8 @@ bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, doubl
   const double slope = (r - dp * v + kappa * c * v).dot(dx);
   const Eigen::VectorXd step = m_assembly.extend(dx);
   const double value = merit(x);
-  // Close to a solution (residual below 1e-4 of the force scale) the merit's change drowns in the
-  // round-off of W; a clear fall of the KKT residual (force and volume, each against its own scale)
-  // then decides.
+  // Close to a solution the merit's change drowns in the round-off of W; a clear fall of the KKT
+  // residual (force and volume, each against its own scale) then decides.
   auto kkt_residual = [&](const Eigen::VectorXd& y, double p) {
     const double force = m_assembly.restrict(residual(y, p)).norm();
     const double volume = (m_model.volume(y) - target_volume) * std::sqrt(kappa) * std::sqrt(base);
@@ -324,22 +320,21 @@ bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, doubl
     return std::isfinite(value) ? value : std::numeric_limits<double>::infinity();
   };
   const double kkt0 = std::hypot(r.norm(), c * std::sqrt(kappa) * std::sqrt(base));
-  const bool near = r.norm() <= 1e-4 * force_scale(x, pressure_mpa);
   double t = 1.0;
   for (int k = 0; k < 30; ++k, t *= 0.5) {
     const Eigen::VectorXd trial = x + t * step;
     const double trial_value = merit(trial);
     if ((std::isfinite(trial_value) && trial_value <= value + 1e-4 * t * std::min(0.0, slope)) ||
-        (near && kkt_residual(trial, pressure_mpa + t * dp) < 0.5 * kkt0)) {
+        kkt_residual(trial, pressure_mpa + t * dp) < 0.5 * kkt0) {
       x = trial;
       pressure_mpa = pressure_mpa + t * dp;
-      m_sqp_full_steps = (k == 0 && shift == 0.0) ? m_sqp_full_steps + 1 : 0;
+      m_sqp_unshifted_steps = shift == 0.0 ? m_sqp_unshifted_steps + 1 : 0;
       if (k > 2) m_sqp_shift = std::max(m_sqp_shift * 4.0, 1e-6 * base);
       return true;
     }
   }
   m_sqp_shift = std::max(m_sqp_shift * 100.0, 1e-4 * base);
-  m_sqp_full_steps = 0;
+  m_sqp_unshifted_steps = 0;
   return true;  // no progress this time; the larger shift shortens the next step
 }
 

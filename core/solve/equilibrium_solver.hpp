@@ -101,7 +101,7 @@ class EquilibriumSolver {
   int m_exact_fails_left = 0;
   int m_last_unstable_modes = 0;
   double m_sqp_shift = 0.0;        ///< Levenberg shift of the last SQP step (N/mm)
-  int m_sqp_full_steps = 0;        ///< consecutive unshifted full SQP steps: close enough for the exact step
+  int m_sqp_unshifted_steps = 0;        ///< consecutive unshifted SQP steps: close enough for the exact step
   bool m_last_step_exact = false;  ///< the last volume step was the exact one
   double m_force_floor = 0.0;  ///< N, see force_scale()
 };
