@@ -316,8 +316,8 @@ bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, doubl
   auto kkt_residual = [&](const Eigen::VectorXd& y, double p) {
     const double force = m_assembly.restrict(residual(y, p)).norm();
     const double volume = (m_model.volume(y) - target_volume) * std::sqrt(kappa) * std::sqrt(base);
-    const double value = std::hypot(force, volume);
-    return std::isfinite(value) ? value : std::numeric_limits<double>::infinity();
+    const double norm = std::hypot(force, volume);
+    return std::isfinite(norm) ? norm : std::numeric_limits<double>::infinity();
   };
   const double kkt0 = std::hypot(r.norm(), c * std::sqrt(kappa) * std::sqrt(base));
   double t = 1.0;

@@ -106,7 +106,9 @@ TEST(BulgeTest, VolumeControlPassesThePressureMaximum) {
   size_t peak = 0;
   for (size_t i = 0; i < curve.points.size(); ++i) {
     if (curve.points[i].pressure_kpa > curve.points[peak].pressure_kpa) peak = i;
-    if (i > 0) EXPECT_GT(curve.points[i].extension_ratio, curve.points[i - 1].extension_ratio);
+    if (i > 0) {
+      EXPECT_GT(curve.points[i].extension_ratio, curve.points[i - 1].extension_ratio);
+    }
   }
   EXPECT_GT(peak, 0u);
   EXPECT_LT(peak, curve.points.size() - 1) << "the sweep should pass the maximum";
