@@ -268,11 +268,14 @@ bool EquilibriumSolver::factorize_exact_for_volume(const Eigen::VectorXd& x, dou
   // A stable volume-controlled state has exactly one negative eigenvalue there (the constraint's); each
   // more is an unstable direction (a wrinkling or symmetry-breaking mode). Newton still converges to such
   // saddles when started close, and the caller's residual line search decides whether a step is good.
-  const int kkt_negative = m_solver.negative_pivots() + (v.dot(m_solver.solve(v)) > 0.0 ? 1 : 0);
-  m_last_unstable_modes = std::max(0, kkt_negative - 1);
+  m_last_unstable_modes = std::max(0, kkt_negative_eigenvalues(v) - 1);
   return true;
 }
 
+
+int EquilibriumSolver::kkt_negative_eigenvalues(const Eigen::VectorXd& v) const {
+  return m_solver.negative_pivots() + (v.dot(m_solver.solve(v)) > 0.0 ? 1 : 0);
+}
 
 bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
                                  const Eigen::VectorXd& v, const Eigen::VectorXd& r, double c) {
@@ -285,7 +288,7 @@ bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, doubl
   double shift = 0.0;
   bool factorized = m_solver.factorize_llt(m_assembly.values()) == SparseSolver::Status::Ok;
   if (!factorized && m_solver.factorize_ldlt(m_assembly.values()) == SparseSolver::Status::Ok &&
-      m_solver.negative_pivots() + (v.dot(m_solver.solve(v)) > 0.0 ? 1 : 0) == 1)
+      kkt_negative_eigenvalues(v) == 1)
     factorized = true;
   if (!factorized) shift = std::max(0.25 * m_sqp_shift, 1e-6 * base);
   while (!factorized) {

@@ -87,6 +87,9 @@ class EquilibriumSolver {
   /// Factorizes K, or K + shift I with the smallest shift found that makes it positive definite.
   bool factorize_stiffness(const Eigen::VectorXd& x, double pressure_mpa);
 
+  /// Negative eigenvalues of the bordered KKT matrix [K v; v^T 0] for the last LDL^T factorization of K
+  /// (Haynsworth: the inertia of K plus the sign of -v^T K^-1 v).
+  int kkt_negative_eigenvalues(const Eigen::VectorXd& v) const;
   /// One SQP step for volume control with a positive definite model of the Hessian (projected membrane
   /// blocks plus a Levenberg shift), globalised on the augmented Lagrangian at the new multiplier.
   bool sqp_step(Eigen::VectorXd& x, double& pressure_mpa, double target_volume, const Eigen::VectorXd& v,
