@@ -206,7 +206,12 @@ NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressur
     m_last_step_exact = false;
     const bool exact_factorized =
         exact_worth_trying && m_exact_fails_left == 0 && factorize_exact_for_volume(x, pressure_mpa, v);
-    if (exact_factorized) {
+    if (exact_factorized && m_last_unstable_modes == 0 && m_solver.negative_pivots() == 0) {
+      // K positive definite: the exact step descends on the augmented Lagrangian, a better guide
+      // than the residual norm far from a solution.
+      exact = constrained_descent(x, pressure_mpa, target_volume, v, r, c);
+      if (!exact) m_exact_fails_left = 2;
+    } else if (exact_factorized) {
       const Eigen::VectorXd a = -m_solver.solve(r);
       const Eigen::VectorXd b = m_solver.solve(v);
       const double vb = v.dot(b);
@@ -297,7 +302,18 @@ bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, doubl
     if (!factorized) shift *= 10.0;
   }
   m_sqp_shift = shift;
-  // KKT step of the convex model: H dx - dp v = -r, v.dx = -c.
+  if (constrained_descent(x, pressure_mpa, target_volume, v, r, c)) {
+    m_sqp_unshifted_steps = shift == 0.0 ? m_sqp_unshifted_steps + 1 : 0;
+    return true;
+  }
+  m_sqp_shift = std::max(m_sqp_shift * 100.0, 1e-4 * base);
+  m_sqp_unshifted_steps = 0;
+  return true;  // no progress this time; the larger shift shortens the next step
+}
+
+bool EquilibriumSolver::constrained_descent(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
+                                            const Eigen::VectorXd& v, const Eigen::VectorXd& r, double c) {
+  // KKT step of the factorized positive definite model H: H dx - dp v = -r, v.dx = -c.
   const Eigen::VectorXd a = m_solver.solve(r);
   const Eigen::VectorXd b = m_solver.solve(v);
   const double vb = v.dot(b);
@@ -305,8 +321,9 @@ bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, doubl
   const double dp = (v.dot(a) - c) / vb;
   const Eigen::VectorXd dx = -a + dp * b;
   const double trial_pressure = pressure_mpa + dp;
+  const double base = std::max(1e-30, m_assembly.mean_abs_diagonal());
   // Merit: the augmented Lagrangian at the new multiplier; along dx its slope is -dx.H.dx - kappa c^2 < 0.
-  const double kappa = m_assembly.mean_abs_diagonal() / v.squaredNorm();
+  const double kappa = base / v.squaredNorm();
   auto merit = [&](const Eigen::VectorXd& y) {
     const double cy = m_model.volume(y) - target_volume;
     return m_model.elastic_energy(y) - trial_pressure * cy + 0.5 * kappa * cy * cy;
@@ -331,14 +348,11 @@ bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, doubl
         kkt_residual(trial, pressure_mpa + t * dp) < 0.5 * kkt0) {
       x = trial;
       pressure_mpa = pressure_mpa + t * dp;
-      m_sqp_unshifted_steps = shift == 0.0 ? m_sqp_unshifted_steps + 1 : 0;
       if (k > 2) m_sqp_shift = std::max(m_sqp_shift * 4.0, 1e-6 * base);
       return true;
     }
   }
-  m_sqp_shift = std::max(m_sqp_shift * 100.0, 1e-4 * base);
-  m_sqp_unshifted_steps = 0;
-  return true;  // no progress this time; the larger shift shortens the next step
+  return false;
 }
 
 }  // namespace balloon

@@ -94,6 +94,10 @@ class EquilibriumSolver {
   /// blocks plus a Levenberg shift), globalised on the augmented Lagrangian at the new multiplier.
   bool sqp_step(Eigen::VectorXd& x, double& pressure_mpa, double target_volume, const Eigen::VectorXd& v,
                 const Eigen::VectorXd& r, double c);
+  /// KKT step of the factorized positive definite Hessian (model), line-searched on the augmented
+  /// Lagrangian at the new multiplier or on a clear fall of the KKT residual. False if no step helped.
+  bool constrained_descent(Eigen::VectorXd& x, double& pressure_mpa, double target_volume, const Eigen::VectorXd& v,
+                           const Eigen::VectorXd& r, double c);
   /// Exact stiffness for the volume-controlled KKT step, accepted when its inertia is right.
   bool factorize_exact_for_volume(const Eigen::VectorXd& x, double pressure_mpa, const Eigen::VectorXd& v);
 

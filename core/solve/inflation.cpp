@@ -13,6 +13,8 @@ namespace balloon {
 namespace {
 
 constexpr double MPA_PER_KPA = 1e-3;
+/// Continuations of one volume step that is still converging slowly (see worth_resuming()).
+constexpr int MAX_RESUMES = 4;
 
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -151,19 +153,32 @@ class InflationRun {
     m_options.progress(event);
   }
 
-  /// One volume step with the predictor; updates `state` on success.
-  bool volume_step(PathPoint& state, double target_volume, NewtonReport& report) {
-    Eigen::VectorXd x = predict(state.x, target_volume);
-    double pressure = state.pressure;
+  /// One volume step, from the predictor or from `resume` (the end of an unfinished attempt at the same
+  /// volume); updates `state` on success and `m_unfinished` on failure.
+  bool volume_step(PathPoint& state, double target_volume, NewtonReport& report, const PathPoint* resume = nullptr) {
+    Eigen::VectorXd x = resume ? resume->x : predict(state.x, target_volume);
+    double pressure = resume ? resume->pressure : state.pressure;
     if (pressure == 0.0) pressure = estimate_pressure(x);
+    m_unfinished_start_residual = m_solver.residual(x, pressure).norm();
     report = m_solver.solve_volume(x, pressure, target_volume, m_settings);
     m_newton_iterations += report.iterations;
-    if (!report.converged) return false;
+    if (!report.converged) {
+      m_unfinished = {x, pressure, target_volume};
+      return false;
+    }
     state = {x, pressure, target_volume};
     m_unstable_modes = report.unstable_modes;
     ++m_load_steps;
     report_progress(state, report.residual_norm, true);
     return true;
+  }
+
+  /// An attempt that ran out of iterations while still halving its residual (a slow creep, as when a
+  /// local dimple pops through at a nearly constant pressure) is worth continuing where it ended:
+  /// a smaller volume step would not help, since the pressure barely changes along such a path.
+  bool worth_resuming(const NewtonReport& report) const {
+    return report.stop == NewtonStop::IterationLimit && std::isfinite(report.residual_norm) &&
+           report.residual_norm < 0.5 * m_unfinished_start_residual;
   }
 
   /// Cancelled or out of time: the run ends there (and m_stop says which).
@@ -183,12 +198,20 @@ class InflationRun {
       message = "no equilibrium found: " + report.message;
       return false;
     }
+    int resumes_left = MAX_RESUMES;
     while (std::abs(target_volume - state.volume) > 1e-14 * target_volume) {
       const double next = std::abs(step) >= std::abs(target_volume - state.volume) ? target_volume : state.volume + step;
       if (volume_step(state, next, report)) {
         if (report.iterations <= 6) step *= 2.0;
+        resumes_left = MAX_RESUMES;
         continue;
       }
+      while (!stopped(report) && worth_resuming(report) && resumes_left > 0) {
+        --resumes_left;
+        const PathPoint unfinished = m_unfinished;
+        if (volume_step(state, next, report, &unfinished)) break;
+      }
+      if (report.converged) continue;
       if (stopped(report)) {
         message = report.message;
         return false;
@@ -295,6 +318,8 @@ class InflationRun {
   int m_newton_iterations = 0;
   int m_load_steps = 0;
   int m_unstable_modes = 0;
+  PathPoint m_unfinished;                   ///< where the last failed attempt ended
+  double m_unfinished_start_residual = 0.0;  ///< N, the residual that attempt started from
   InflationStop m_stop = InflationStop::NoEquilibrium;
 };
 
