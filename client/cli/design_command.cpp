@@ -184,8 +184,8 @@ std::string summary_from_report(const v1::DesignReport& report, const std::strin
       << shown_number(report.has_baseline_avg_error_mm(), report.baseline_avg_error_mm(), "%.4g") << " mm, max "
       << shown_number(report.has_baseline_max_error_mm(), report.baseline_max_error_mm(), "%.4g")
       << " mm (the downscaled target inflated)\n";
-  out << "  inflation      " << format("%.5g", report.pressure_kpa()) << " kPa, volume ratio "
-      << format("%.4g", report.volume_ratio()) << ", " << report.vertices() << " vertices\n";
+  out << "  inflation      " << shown_number(report.has_pressure_kpa(), report.pressure_kpa(), "%.5g")
+      << " kPa, volume ratio " << shown_number(report.has_volume_ratio(), report.volume_ratio(), "%.4g") << ", " << report.vertices() << " vertices\n";
   if (report.has_tolerance() && report.tolerance().levels_size() > 0) {
     out << "  tolerance     ";
     for (const v1::ToleranceLevel& level : report.tolerance().levels())

@@ -86,8 +86,8 @@ struct DesignResult {
   DesignMethod method = DesignMethod::Adjoint;
   TriMesh rest;                        ///< the balloon to fabricate (mm)
   Positions inflated;                  ///< its predicted inflated shape, rigidly aligned to the target (mm)
-  double pressure_kpa = 0.0;
-  double volume_ratio = 0.0;           ///< inflated volume / rest volume
+  /// The design's inflation (kPa, inflated / rest volume); none when no start was inflated.
+  std::optional<double> pressure_kpa, volume_ratio;
   int iterations = 0;
   std::optional<int> resumed_from_iteration;  ///< set when the design continued from a checkpoint
   double time_s = 0.0;
@@ -98,8 +98,8 @@ struct DesignResult {
   double bbox_diag_mm = 0.0;
   /// The start (downscaled target) inflated (mm); empty when it could not be inflated.
   std::optional<double> baseline_avg_error_mm, baseline_max_error_mm;
-  double distance_energy = 0.0;        ///< E_dist at the end (mm)
-  double residual_norm = 0.0;          ///< force residual of the inflated shape (N)
+  std::optional<double> distance_energy;  ///< E_dist at the end (mm); none without a design
+  std::optional<double> residual_norm;    ///< force residual of the inflated shape (N); none without a design
   /// The objective's terms and constraints that took part: "distance" always; "surface" (k_surface > 0);
   /// "fixed_rest_volume"
   /// (adjoint: the rest volume is held at target volume / ratio); "max_volume" (alm, once a rest region

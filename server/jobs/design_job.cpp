@@ -175,7 +175,7 @@ DesignOutcome run_design(const DesignInput& input, const RunControls& controls,
     // The design's inflated shape is aligned to the target, not in the rest frame where the nozzle holds
     // its vertices: re-inflate the nominal design in place so every sample starts from its equilibrium.
     nominal.control = InflationControl::VolumeRatio;
-    nominal.volume_ratio = outcome.result.volume_ratio;
+    nominal.volume_ratio = outcome.result.volume_ratio.value_or(DesignOptions{}.volume_ratio);
     const InflationResult reference = inflate(outcome.result.rest, nominal);
     const Positions& nominal_shape = reference.converged ? reference.deformed : outcome.result.inflated;
     outcome.tolerance = thickness_tolerance(outcome.result.rest, nominal, nominal_shape,

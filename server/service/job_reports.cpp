@@ -59,8 +59,8 @@ v1::DesignReport design_report(const jobs::DesignInput& input, const jobs::Desig
   if (const std::optional<double> value = result.avg_error_rel) report.set_avg_error_rel(*value);
   if (const std::optional<double> value = result.max_error_rel) report.set_max_error_rel(*value);
   report.set_bbox_diag_mm(result.bbox_diag_mm);
-  report.set_pressure_kpa(result.pressure_kpa);
-  report.set_volume_ratio(result.volume_ratio);
+  if (const std::optional<double> value = result.pressure_kpa) report.set_pressure_kpa(*value);
+  if (const std::optional<double> value = result.volume_ratio) report.set_volume_ratio(*value);
   report.set_iterations(result.iterations);
   report.set_time_s(result.time_s);
   report.set_vertices(result.rest.vertex_count());
@@ -72,8 +72,8 @@ v1::DesignReport design_report(const jobs::DesignInput& input, const jobs::Desig
     report.set_baseline_avg_error_rel(*value);
   if (const std::optional<double> value = ratio(result.baseline_avg_error_mm, result.avg_error_mm))
     report.set_improvement_over_baseline(*value);
-  report.set_distance_energy(result.distance_energy);
-  report.set_residual_norm(result.residual_norm);
+  if (const std::optional<double> value = result.distance_energy) report.set_distance_energy(*value);
+  if (const std::optional<double> value = result.residual_norm) report.set_residual_norm(*value);
   report.set_material(material_spec(input.material));
   report.set_material_name(input.material.name);
   report.set_thickness_mm(input.parameters.thickness_mm);

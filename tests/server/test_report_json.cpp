@@ -26,6 +26,10 @@ v1::DesignReport design_with_errors() {
   report.set_avg_error_rel(0.0025);
   report.set_max_error_rel(0.015);
   report.set_bbox_diag_mm(100.0);
+  report.set_pressure_kpa(3.5);
+  report.set_volume_ratio(8.0);
+  report.set_distance_energy(0.01);
+  report.set_residual_norm(1e-7);
   report.set_iterations(42);
   report.add_active_terms("distance");
   report.mutable_convergence()->add_time_s(0.1);
@@ -41,7 +45,8 @@ TEST(ReportJson, AnErrorNeverComputedIsNullAndAnInapplicableCountIsAbsent) {
   report.set_mold_problem("the design produced no rest shape");
   const std::string json = report_json(report);
   for (const char* key : {"avg_error_mm", "max_error_mm", "avg_error_rel", "max_error_rel", "baseline_avg_error_mm",
-                          "baseline_max_error_mm", "improvement_over_baseline"})
+                          "baseline_max_error_mm", "improvement_over_baseline", "pressure_kpa", "volume_ratio",
+                          "distance_energy", "residual_norm"})
     EXPECT_NE(json.find(std::string("\"") + key + "\":null"), std::string::npos) << key << " in " << json;
   EXPECT_EQ(json.find("\"avg_error_mm\":0"), std::string::npos) << json;
   EXPECT_EQ(json.find("resumed_from_iteration"), std::string::npos) << "absent when the design ran through";

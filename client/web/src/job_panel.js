@@ -384,7 +384,7 @@ export class JobPanel {
     const { readouts, summary } = this.m_elements;
     if (report.avg_error_mm != null) readouts.avg_error.textContent = format_error_mm(report.avg_error_mm);
     if (report.max_error_mm != null) readouts.max_error.textContent = format_error_mm(report.max_error_mm);
-    if (report.pressure_kpa !== undefined) readouts.pressure.textContent = format_number(report.pressure_kpa, 4);
+    if (report.pressure_kpa != null) readouts.pressure.textContent = format_number(report.pressure_kpa, 4);
     if (report.time_s !== undefined) readouts.elapsed.textContent = format_number(report.time_s, 3);
     if (report.iterations !== undefined) readouts.iteration.textContent = String(report.iterations);
 
@@ -401,7 +401,7 @@ export class JobPanel {
         `(${format_number(100 * report.avg_error_rel, 3)} % / ${format_number(100 * report.max_error_rel, 3)} %).`);
     if (report.baseline_avg_error_mm != null)
       lines.push(`Just shrinking the target would give an average error of ${format_error_mm(report.baseline_avg_error_mm)} mm.`);
-    if (report.pressure_kpa !== undefined)
+    if (report.pressure_kpa != null)
       lines.push(`Inflate to ${format_number(report.pressure_kpa, 4)} kPa; volume ratio ${format_number(report.volume_ratio, 4)}; ` +
         `${report.vertices ?? '?'} vertices; ${report.material_name || report.material || ''}, ${format_number(report.thickness_mm, 3)} mm thick.`);
     if (report.mold_problem) lines.push(`No mold: ${report.mold_problem}`);
