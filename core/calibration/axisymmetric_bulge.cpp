@@ -226,6 +226,7 @@ DimensionlessCurve trace(const Material& shape, double max_area_ratio, double ma
   const StretchDerivatives s1 = stretch_derivatives(shape, 1.0 + 1e-3, 1.0 + 1e-3);
   const double stiffness = std::max(s1.w1 / 1e-3, 1e-12);
   double t = 0.0;
+  int past_extent = 0;
   for (int k = 1; k < options.max_points; ++k) {
     t += k == 1 ? 0.5 * dt : dt;
     const double l0 = 1.0 + t * t;
@@ -253,7 +254,8 @@ DimensionlessCurve trace(const Material& shape, double max_area_ratio, double ma
       return curve;
     }
     curve.points.push_back(Point{t, P, shot.height, shot.area, shot.volume});
-    if (shot.area >= max_area_ratio && shot.height >= max_height) {
+    // Two points past the extent, so the last interval used has centred slopes on both sides.
+    if (shot.area >= max_area_ratio && shot.height >= max_height && ++past_extent > 2) {
       curve.converged = true;
       curve.message = "converged";
       return curve;
@@ -270,22 +272,31 @@ double scaled_pressure(const Point& p) { return p.pressure / (p.t * p.t * p.t); 
 double scaled_area(const Point& p) { return (p.area_ratio - 1.0) / (p.t * p.t); }
 double scaled_height(const Point& p) { return p.height / p.t; }
 
+/// The scaled quantities are smooth functions of the strain l0 - 1 = t^2, so even in t: near the flat disc
+/// they follow a + b t^2 through the first two points.
+double even_coefficient(const std::vector<Point>& points, double (*value)(const Point&)) {
+  return (value(points[2]) - value(points[1])) / (points[2].t * points[2].t - points[1].t * points[1].t);
+}
+
 /// Cubic Hermite interpolation of v(t) over the points after the flat disc (index >= 1), slopes by finite
-/// differences on the non-uniform neighbours (exact for quadratics), one-sided at the ends.
+/// differences on the non-uniform neighbours (exact for quadratics), from the even fit at the first point,
+/// one-sided at the last (the curve runs two points past what it is asked for).
 double slope(const std::vector<Point>& points, size_t k, double (*value)(const Point&)) {
   const size_t n = points.size();
   if (n < 3) return 0.0;
-  if (k <= 1) return (value(points[2]) - value(points[1])) / (points[2].t - points[1].t);
+  if (k <= 1) return 2.0 * even_coefficient(points, value) * points[1].t;
   if (k == n - 1) return (value(points[k]) - value(points[k - 1])) / (points[k].t - points[k - 1].t);
   const double h0 = points[k].t - points[k - 1].t, h1 = points[k + 1].t - points[k].t;
   const double d0 = (value(points[k]) - value(points[k - 1])) / h0, d1 = (value(points[k + 1]) - value(points[k])) / h1;
   return (h1 * d0 + h0 * d1) / (h0 + h1);
 }
 
-/// v(t) in the step [t_k, t_k+1] (k >= 1); below the first point (k = 0) the first point's value, the
-/// small-strain limit to O(t^2).
+/// v(t) in the step [t_k, t_k+1] (k >= 1); below the first point (k = 0) the even fit a + b t^2.
 double hermite(const std::vector<Point>& points, size_t k, double t, double (*value)(const Point&)) {
-  if (k == 0) return value(points[1]);
+  if (k == 0) {
+    if (points.size() < 3) return value(points[1]);
+    return value(points[1]) + even_coefficient(points, value) * (t * t - points[1].t * points[1].t);
+  }
   const double h = points[k + 1].t - points[k].t, u = (t - points[k].t) / h;
   const double h00 = (1 + 2 * u) * (1 - u) * (1 - u), h10 = u * (1 - u) * (1 - u), h01 = u * u * (3 - 2 * u),
                h11 = u * u * (u - 1);

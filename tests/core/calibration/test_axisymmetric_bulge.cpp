@@ -125,7 +125,7 @@ TEST(AxisymmetricBulge, MatchesTheFineShootingReferenceForEveryLaw) {
 
 TEST(AxisymmetricBulge, CurveInterpolationMatchesTheStatesItPassesBetween) {
   // States solved at pole stretches between the curve's points, read back from the curve by extension
-  // ratio and by apex height: the interpolation error of the fit's model (measured 1e-4 to 9e-4).
+  // ratio and by apex height: the interpolation error of the fit's model (measured up to 5e-4).
   for (const Material& material : three_laws()) {
     const AxisymmetricBulgeCurve curve = axisymmetric_bulge_curve(material, RADIUS, THICKNESS, 2.7, 0.0);
     ASSERT_TRUE(curve.converged) << curve.message;
@@ -260,9 +260,10 @@ TEST(AxisymmetricBulgeFit, RecoversHartSmithFromExactDataWithAndWithoutApexHeigh
     // Exact data and an exact model: the residual is the interpolation error (< 1e-3), and the constants
     // come back to well within the flat G-k2 valley the FEM-corrected fit got lost in (G 6%, k2 0.30).
     EXPECT_LT(fit->rms_relative_residual, 1e-3);
-    EXPECT_NEAR(fit->material.params[0], 0.2, 0.01 * 0.2);
-    EXPECT_NEAR(fit->material.params[1], 3e-3, 0.05 * 3e-3);
-    EXPECT_NEAR(fit->material.params[2], 0.5, 0.05 * 0.5);
+    // Measured: G, k1 and k2 within 0.1%.
+    EXPECT_NEAR(fit->material.params[0], 0.2, 0.005 * 0.2);
+    EXPECT_NEAR(fit->material.params[1], 3e-3, 0.02 * 3e-3);
+    EXPECT_NEAR(fit->material.params[2], 0.5, 0.02 * 0.5);
   }
 }
 
