@@ -29,8 +29,9 @@ using BulgeModel = std::function<std::vector<double>(const Material& material, c
 /// uniformly stretched (planar tension at the rim, larger stretch at the pole); at small strain it gives
 /// p = 12 mu H t^3 / a (t = h / a), whose coefficient differs from the exact small-deflection membrane
 /// solution (Hencky) by very roughly 10-20%, so fitted moduli carry an error of that order. Apex heights
-/// in the set are not used (the cap ties them to rho). The FEM bulge simulation replaces this model
-/// through FitOptions::bulge_model.
+/// in the set are not used (the cap ties them to rho). The exact axisymmetric membrane of
+/// core/calibration/axisymmetric_bulge replaces this model through FitOptions::bulge_model (the fit job
+/// always does).
 std::vector<double> spherical_cap_bulge_pressures(const Material& material, const MeasurementSet& set);
 
 /// Options of fit_material(). Defaults suit stress tables and the spherical-cap bulge model.
