@@ -9,6 +9,10 @@
 
 namespace balloon {
 
+/// Superseded: the fit job now fits bulge sets with the exact axisymmetric membrane inside the least squares
+/// (calibration/axisymmetric_bulge), about ten times faster and without the valley drift described below.
+/// Kept as the "before" of tests/bench/bench_fitting and as a fit against the 3D FEM disc itself.
+///
 /// fit_material() with bulge sets simulated by the FEM disc, made fast by a corrected spherical cap: the
 /// bulge model inside the least squares is spherical_cap_bulge_pressures(m) * c(rho), where the correction
 /// c = p_FEM / p_cap is computed by one FEM sweep at the current fit; refit, recompute c at the new fit, and

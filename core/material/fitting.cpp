@@ -266,9 +266,12 @@ std::vector<double> model_values(const Material& material, const MeasurementSet&
                                  const FitOptions& options) {
   if (set.kind == TestKind::Bulge) {
     MeasurementSet query = set;
+    // The model must not look at the data: the pressures go; the apex heights are abscissae of the data
+    // points (a model may prefer them to extension ratios), so they stay only at the data's own points.
+    const bool at_data_points = x == set.x;
     query.x = x;
-    query.y.assign(x.size(), 0.0);  // the model must not look at the data
-    query.apex_height_mm.clear();
+    query.y.assign(x.size(), 0.0);
+    if (!at_data_points) query.apex_height_mm.clear();
     return options.bulge_model ? options.bulge_model(material, query) : spherical_cap_bulge_pressures(material, query);
   }
   std::vector<double> y(x.size());

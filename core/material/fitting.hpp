@@ -13,9 +13,10 @@
 
 namespace balloon {
 
-/// Model pressures (kPa) of a bulge set at each of its extension ratios set.x (#points), for `material`
-/// on a disc of radius set.disc_radius_mm and thickness set.thickness_mm. Entries may be NaN where the
-/// model cannot reach that extension ratio (they then count as a large residual).
+/// Model pressures (kPa) of a bulge set at each of its points (#set.x), for `material` on a disc of radius
+/// set.disc_radius_mm and thickness set.thickness_mm: at the extension ratios set.x, or at the apex heights
+/// set.apex_height_mm where the set carries them (they do only at the measured points; set.y is zeroed).
+/// Entries may be NaN where the model cannot reach a point (they then count as a large residual).
 using BulgeModel = std::function<std::vector<double>(const Material& material, const MeasurementSet& set)>;
 
 /// Bulge-test model in the thin-membrane spherical-cap approximation (no FEM). Assumptions: the disc of
@@ -28,8 +29,9 @@ using BulgeModel = std::function<std::vector<double>(const Material& material, c
 /// uniformly stretched (planar tension at the rim, larger stretch at the pole); at small strain it gives
 /// p = 12 mu H t^3 / a (t = h / a), whose coefficient differs from the exact small-deflection membrane
 /// solution (Hencky) by very roughly 10-20%, so fitted moduli carry an error of that order. Apex heights
-/// in the set are not used (the cap ties them to rho). The FEM bulge simulation replaces this model
-/// through FitOptions::bulge_model.
+/// in the set are not used (the cap ties them to rho). The exact axisymmetric membrane of
+/// core/calibration/axisymmetric_bulge replaces this model through FitOptions::bulge_model (the fit job
+/// always does).
 std::vector<double> spherical_cap_bulge_pressures(const Material& material, const MeasurementSet& set);
 
 /// Options of fit_material(). Defaults suit stress tables and the spherical-cap bulge model.
@@ -72,6 +74,7 @@ Regimes detect_regimes(const std::vector<double>& x, const std::vector<double>& 
 std::vector<double> regime_curve(const MeasurementSet& set);
 
 /// Model values y (MPa or kPa, as set.y) at the abscissae `x` (#x) for the geometry and kind of `set`.
+/// A bulge model sees the set's apex heights only when `x` is the set's own x.
 std::vector<double> model_values(const Material& material, const MeasurementSet& set, const std::vector<double>& x,
                                  const FitOptions& options = {});
 

@@ -14,15 +14,10 @@
 #include <sstream>
 
 #include "jobs/json_writer.hpp"
-#include "calibration/bulge_simulation.hpp"
-#include "calibration/fem_bulge_fit.hpp"
+#include "calibration/axisymmetric_bulge.hpp"
 
 namespace balloon::jobs {
 namespace {
-
-/// Rings of the FEM disc used for bulge data: 817 vertices; pressures within about 0.5% of the
-/// axisymmetric solution (tests/core/calibration/test_bulge_simulation.cpp), a sweep in well under a second.
-constexpr int FIT_BULGE_RINGS = 16;
 
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -134,9 +129,11 @@ Result<FitOutcome> run_fit(const FitInput& input, const CancelToken* cancel) {
   const double start = now_s();
   FitOptions options;
   options.cancel = cancel;
+  // Bulge sets: the exact axisymmetric membrane inside the least squares (one 1D solve per evaluation).
+  options.bulge_model = axisymmetric_bulge_model();
   for (MaterialModel model : input.models) {
     if (cancel != nullptr && cancel->cancelled()) return fail(FIT_CANCELLED);
-    Result<FitResult> fit = fit_material_with_fem_bulge(model, input.sets, options, FIT_BULGE_RINGS);
+    Result<FitResult> fit = fit_material(model, input.sets, options);
     if (!fit) return fail(model_name(model) + ": " + fit.error());
     outcome.fits.push_back(std::move(*fit));
   }
@@ -261,7 +258,7 @@ std::string fit_plot_svg(const FitInput& input, const FitOutcome& outcome) {
       << "\" viewBox=\"0 0 " << WIDTH << " " << height << "\" font-family=\"sans-serif\" font-size=\"12\">\n";
   svg << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
   FitOptions options;
-  options.bulge_model = fem_bulge_model(FIT_BULGE_RINGS);
+  options.bulge_model = axisymmetric_bulge_model();
   for (size_t s = 0; s < input.sets.size(); ++s) {
     const MeasurementSet& set = input.sets[s];
     const bool bulge = set.kind == TestKind::Bulge;

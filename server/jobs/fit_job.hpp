@@ -41,8 +41,8 @@ struct FitOutcome {
   double time_s = 0.0;  ///< wall time of all fits (s)
 };
 
-/// Fits every model. Bulge sets use the FEM bulge simulation (core/calibration/bulge_simulation) through
-/// fit_material_with_fem_bulge (a spherical cap corrected by FEM sweeps at the current fit).
+/// Fits every model. Bulge sets are simulated by the axisymmetric membrane (core/calibration/
+/// axisymmetric_bulge) at their apex heights when the data has them, else at their extension ratios.
 /// Fails with a message when the data cannot be fitted (e.g. fewer points than parameters), or with
 /// FIT_CANCELLED once `cancel` (may be null) fires: it is checked between iterations of every fit.
 Result<FitOutcome> run_fit(const FitInput& input, const CancelToken* cancel = nullptr);
