@@ -1,16 +1,23 @@
-// Inverse-design benchmark (issue 4): per sample shape (bunny, spot, blob at a 100 mm bounding-box
-// diagonal, remeshed to --resolution vertices, silicone, --volume-ratio 8) and per method (adjoint, alm):
-// vertices, time, iterations, average and maximum error, and the baseline error (the downscaled target
-// inflated). Writes the error-against-time curves as CSV (one file per shape and method) and one SVG
-// plot per shape into OUT_DIR, and compares the run times with the paper's Table 1.
-// Usage: bench_design [OUT_DIR=./bench-design-out] [--data DIR] [--resolution N=3000] [--max-time S=60]
-//                     [--volume-ratio R=8] [--method adjoint|alm (default: both)] [--quick]   (--quick: bunny only, 1000 vertices, 20 s per design)
+// Inverse-design benchmark (issues 4 and 10): per shape and per method (adjoint, alm): vertices, time,
+// iterations, average and maximum error, the baseline error (the downscaled target inflated) and the
+// improvement over it. Writes the error-against-time curves as CSV (one file per shape, material and
+// method) and one SVG plot per shape and material into OUT_DIR.
+// Default: the three sample shapes (bunny, spot, blob) at a 100 mm bounding-box diagonal, silicone.
+// --corpus: every mesh in DATA_DIR/meshes at a 150 mm diagonal, silicone and latex, 4000 vertices (the
+// corpus of issue 10, section 2), then a summary per material and method against the issue's targets
+// (no failed start; average error <= 1% of the diagonal and >= 3x better than the baseline on >= 90% of the
+// shapes; >= 2x on all; median <= 0.7%), also written as OUT_DIR/design_table.md for the README.
+// Usage: bench_design [OUT_DIR=./bench-design-out] [--data DIR] [--corpus] [--mesh SUBSTRING]...
+//                     [--material silicone|latex|SPEC]... [--resolution N=3000 (4000 with --corpus)]
+//                     [--max-time S=60] [--volume-ratio R=8] [--method adjoint|alm (default: both)]
+//                     [--quick]   (--quick: bunny only, 1000 vertices, 20 s per design)
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,8 +32,53 @@ namespace {
 
 struct Run {
   std::string shape;
+  std::string material;
   balloon::DesignResult result;
 };
+
+double median(std::vector<double> values) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+bool selected(const std::vector<std::string>& filters, const std::string& name) {
+  if (filters.empty()) return true;
+  return std::any_of(filters.begin(), filters.end(),
+                     [&](const std::string& f) { return name.find(f) != std::string::npos; });
+}
+
+/// Issue 10's design targets over one material and method: counts, medians and whether each holds.
+/// A design without an error (failed start, no inflation) counts against every target.
+std::string target_summary(const std::string& material, const std::string& method, const std::vector<const Run*>& runs) {
+  int failed_starts = 0, within_1pct_3x = 0, at_least_2x = 0;
+  std::vector<double> errors_pct, times;
+  for (const Run* run : runs) {
+    const balloon::DesignResult& r = run->result;
+    times.push_back(r.time_s);
+    if (r.stop == balloon::DesignStop::StartFailed || !r.baseline_avg_error_mm) ++failed_starts;
+    if (!r.avg_error_rel) {
+      errors_pct.push_back(std::numeric_limits<double>::infinity());
+      continue;
+    }
+    const double pct = 100.0 * *r.avg_error_rel;
+    errors_pct.push_back(pct);
+    const double improvement = r.baseline_avg_error_mm ? *r.baseline_avg_error_mm / *r.avg_error_mm : 0.0;
+    if (pct <= 1.0 && improvement >= 3.0) ++within_1pct_3x;
+    if (improvement >= 2.0) ++at_least_2x;
+  }
+  const int n = static_cast<int>(runs.size());
+  const double med = median(errors_pct);
+  char buf[512];
+  std::snprintf(buf, sizeof(buf),
+                "| %s | %s | %d | %d %s | %d/%d (%.0f%%) %s | %d/%d %s | %.3g%% %s | %.1f s | %.1f s |\n",
+                material.c_str(), method.c_str(), n, failed_starts, failed_starts == 0 ? "ok" : "MISS", within_1pct_3x, n,
+                n ? 100.0 * within_1pct_3x / n : 0.0, within_1pct_3x >= 0.9 * n ? "ok" : "MISS", at_least_2x, n,
+                at_least_2x == n ? "ok" : "MISS", med, med <= 0.7 ? "ok" : "MISS", median(times),
+                times.empty() ? 0.0 : *std::max_element(times.begin(), times.end()));
+  return buf;
+}
 
 const char* COLORS[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"};
 
@@ -104,18 +156,26 @@ std::string svg_plot(const std::string& title, const std::vector<const Run*>& ru
 int main(int argc, char** argv) {
   std::string out_dir = "bench-design-out";
   std::string data_dir = BALLOON_TEST_DATA_DIR;
-  int resolution = 3000;
+  int resolution = 0;
   double max_time_s = 60.0;
   bool quick = false;
+  bool corpus = false;
   double volume_ratio = 8.0;
+  std::vector<std::string> mesh_filters, material_specs;
   std::vector<balloon::DesignMethod> methods = {balloon::DesignMethod::Adjoint,
                                                 balloon::DesignMethod::AugmentedLagrangian};
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--quick") {
       quick = true;
+    } else if (arg == "--corpus") {
+      corpus = true;
     } else if (arg == "--data" && i + 1 < argc) {
       data_dir = argv[++i];
+    } else if (arg == "--mesh" && i + 1 < argc) {
+      mesh_filters.push_back(argv[++i]);
+    } else if (arg == "--material" && i + 1 < argc) {
+      material_specs.push_back(argv[++i]);
     } else if (arg == "--resolution" && i + 1 < argc) {
       resolution = std::atoi(argv[++i]);
     } else if (arg == "--max-time" && i + 1 < argc) {
@@ -132,79 +192,108 @@ int main(int argc, char** argv) {
     } else if (!arg.empty() && arg[0] != '-') {
       out_dir = arg;
     } else {
-      std::fprintf(stderr, "usage: bench_design [OUT_DIR] [--data DIR] [--resolution N] [--max-time S] [--volume-ratio R] [--method adjoint|alm] [--quick]\n");
+      std::fprintf(stderr,
+                   "usage: bench_design [OUT_DIR] [--data DIR] [--corpus] [--mesh SUBSTRING]... [--material SPEC]... "
+                   "[--resolution N] [--max-time S] [--volume-ratio R] [--method adjoint|alm] [--quick]\n");
       return 2;
     }
   }
+  if (resolution <= 0) resolution = corpus ? 4000 : 3000;
   if (quick) {
     resolution = 1000;
     max_time_s = 20.0;
   }
+  if (material_specs.empty()) material_specs = corpus ? std::vector<std::string>{"silicone", "latex"}
+                                                      : std::vector<std::string>{"silicone"};
+  std::vector<balloon::Material> materials;
+  for (const std::string& spec : material_specs) {
+    auto material = balloon::parse_material_spec(spec);
+    if (!material) {
+      std::fprintf(stderr, "bench_design: %s\n", material.error().c_str());
+      return 2;
+    }
+    materials.push_back(*material);
+  }
   std::filesystem::create_directories(out_dir);
-  const auto material = balloon::parse_material_spec("silicone");
   struct Shape {
-    const char* name;
-    const char* file;
+    std::string name;
+    std::string file;
   };
-  std::vector<Shape> shapes = {{"bunny", "stanford_bunny_1839.obj"}, {"spot", "spot.obj"},
-                               {"blob", "retinal_bumpy_blob.off"}};
-  if (quick) shapes.resize(1);
-
-  std::printf("inverse design: %s, thickness 0.5 mm, volume ratio %g, 100 mm bbox diagonal, ~%d vertices, "
+  std::vector<Shape> shapes;
+  if (corpus) {
+    for (const auto& entry : std::filesystem::directory_iterator(data_dir + "/meshes")) {
+      const std::string file = entry.path().filename().string();
+      const std::string ext = entry.path().extension().string();
+      if (ext == ".off" || ext == ".obj" || ext == ".stl" || ext == ".ply")
+        shapes.push_back({entry.path().stem().string(), file});
+    }
+    std::sort(shapes.begin(), shapes.end(), [](const Shape& a, const Shape& b) { return a.name < b.name; });
+  } else {
+    shapes = {{"bunny", "stanford_bunny_1839.obj"}, {"spot", "spot.obj"}, {"blob", "retinal_bumpy_blob.off"}};
+    if (quick) shapes.resize(1);
+  }
+  shapes.erase(std::remove_if(shapes.begin(), shapes.end(), [&](const Shape& s) { return !selected(mesh_filters, s.file); }),
+               shapes.end());
+  const double size_mm = corpus ? 150.0 : 100.0;
+  std::printf("inverse design: thickness 0.5 mm, volume ratio %g, %.0f mm bbox diagonal, ~%d vertices, "
               "budget %.0f s per design\n",
-              balloon::material_spec(*material).c_str(), volume_ratio, resolution, max_time_s);
-  std::printf("%-6s %-8s %8s %9s %6s %11s %11s %9s %12s %12s %9s  %s\n", "shape", "method", "vertices", "time_s",
-              "iters", "avg_err_mm", "max_err_mm", "avg_%diag", "base_avg_mm", "base_max_mm", "improve", "status");
+              volume_ratio, size_mm, resolution, max_time_s);
+  std::printf("%-22s %-9s %-8s %8s %9s %6s %11s %11s %9s %12s %12s %9s  %s\n", "shape", "material", "method", "vertices",
+              "time_s", "iters", "avg_err_mm", "max_err_mm", "avg_%diag", "base_avg_mm", "base_max_mm", "improve",
+              "status");
   std::vector<Run> runs;
   for (const Shape& shape : shapes) {
     auto mesh = balloon::read_mesh(data_dir + "/meshes/" + shape.file);
     if (!mesh) {
-      std::printf("%-6s cannot load %s: %s\n", shape.name, shape.file, mesh.error().c_str());
+      std::printf("%-22s cannot load %s: %s\n", shape.name.c_str(), shape.file.c_str(), mesh.error().c_str());
       continue;
     }
     balloon::TargetPreparationOptions prep;
-    prep.size_mm = 100.0;
+    prep.size_mm = size_mm;
     prep.resolution = resolution;
     auto target = balloon::prepare_target(std::move(*mesh), prep);
     if (!target) {
-      std::printf("%-6s cannot prepare: %s\n", shape.name, target.error().c_str());
+      std::printf("%-22s cannot prepare: %s\n", shape.name.c_str(), target.error().c_str());
       continue;
     }
-    std::vector<const Run*> shape_runs;
-    for (const auto method : methods) {
-      // A method the optimizer does not offer (yet) is reported, not run under another name.
-      const std::string method_name = balloon::design_method_name(method);
-      if (auto offered = balloon::parse_design_method(method_name); !offered) {
-        std::printf("%-6s %-8s not run: %s\n", shape.name, method_name.c_str(), offered.error().c_str());
-        continue;
+    for (size_t m = 0; m < materials.size(); ++m) {
+      const std::string material_label = material_specs[m];
+      std::vector<const Run*> shape_runs;
+      for (const auto method : methods) {
+        // A method the optimizer does not offer (yet) is reported, not run under another name.
+        const std::string method_name = balloon::design_method_name(method);
+        if (auto offered = balloon::parse_design_method(method_name); !offered) {
+          std::printf("%-22s %-8s not run: %s\n", shape.name.c_str(), method_name.c_str(), offered.error().c_str());
+          continue;
+        }
+        balloon::DesignOptions options;
+        options.material = materials[m];
+        options.thickness_mm = 0.5;
+        options.volume_ratio = volume_ratio;
+        options.method = method;
+        options.max_time_s = max_time_s;
+        runs.push_back({shape.name, material_label, balloon::design_balloon(target->mesh, options)});
+        const balloon::DesignResult& r = runs.back().result;
+        // A value that was never computed prints as nan, never as 0.
+        const auto shown = [](const std::optional<double>& value) {
+          return value.value_or(std::numeric_limits<double>::quiet_NaN());
+        };
+        std::printf("%-22s %-9s %-8s %8d %9.2f %6d %11.4g %11.4g %9.3f %12.4g %12.4g %8.1fx  %s: %s\n",
+                    shape.name.c_str(), material_label.c_str(), method_name.c_str(), r.rest.vertex_count(), r.time_s,
+                    r.iterations, shown(r.avg_error_mm), shown(r.max_error_mm), 100.0 * shown(r.avg_error_rel),
+                    shown(r.baseline_avg_error_mm), shown(r.baseline_max_error_mm),
+                    shown(r.baseline_avg_error_mm) / shown(r.avg_error_mm), balloon::design_stop_name(r.stop).c_str(),
+                    r.message.c_str());
+        std::fflush(stdout);
+        const std::string stem = out_dir + "/" + shape.name + (corpus ? "_" + material_label : "");
+        std::ofstream(stem + "_" + method_name + "_convergence.csv") << balloon::jobs::convergence_csv(r.log);
       }
-      balloon::DesignOptions options;
-      options.material = *material;
-      options.thickness_mm = 0.5;
-      options.volume_ratio = volume_ratio;
-      options.method = method;
-      options.max_time_s = max_time_s;
-      runs.push_back({shape.name, balloon::design_balloon(target->mesh, options)});
-      const balloon::DesignResult& r = runs.back().result;
-      // A value that was never computed prints as nan, never as 0.
-      const auto shown = [](const std::optional<double>& value) {
-        return value.value_or(std::numeric_limits<double>::quiet_NaN());
-      };
-      std::printf("%-6s %-8s %8d %9.2f %6d %11.4g %11.4g %9.3f %12.4g %12.4g %8.1fx  %s: %s\n", shape.name,
-                  balloon::design_method_name(method).c_str(), r.rest.vertex_count(), r.time_s, r.iterations,
-                  shown(r.avg_error_mm), shown(r.max_error_mm), 100.0 * shown(r.avg_error_rel),
-                  shown(r.baseline_avg_error_mm), shown(r.baseline_max_error_mm),
-                  shown(r.baseline_avg_error_mm) / shown(r.avg_error_mm), balloon::design_stop_name(r.stop).c_str(),
-                  r.message.c_str());
-      std::fflush(stdout);
-      const std::string csv_path =
-          out_dir + "/" + shape.name + "_" + balloon::design_method_name(method) + "_convergence.csv";
-      std::ofstream(csv_path) << balloon::jobs::convergence_csv(r.log);
+      for (const Run& run : runs)
+        if (run.shape == shape.name && run.material == material_label) shape_runs.push_back(&run);
+      const std::string stem = out_dir + "/" + shape.name + (corpus ? "_" + material_label : "");
+      std::ofstream(stem + "_error_vs_time.svg")
+          << svg_plot(shape.name + " (" + material_label + "): average error against time", shape_runs);
     }
-    for (const Run& run : runs)
-      if (run.shape == shape.name) shape_runs.push_back(&run);
-    std::ofstream(out_dir + "/" + shape.name + "_error_vs_time.svg")
-        << svg_plot(std::string(shape.name) + ": average error against time", shape_runs);
   }
   if (!runs.empty()) {
     double fastest = 1e300, slowest = 0.0;
@@ -213,10 +302,24 @@ int main(int argc, char** argv) {
       slowest = std::max(slowest, run.result.time_s);
     }
     std::printf("paper Table 1: 66 s to 5000 s per design (their CPU, 2012); here: %.1f s to %.1f s per design "
-                "(%d designs, budget %.0f s); issue target: under 30 s for 5k vertices\n",
+                "(%d designs, budget %.0f s); issue target: under 30 s for 4k vertices\n",
                 fastest, slowest, static_cast<int>(runs.size()), max_time_s);
   }
-  std::printf("curves: %s/<shape>_<method>_convergence.csv, plots: %s/<shape>_error_vs_time.svg\n", out_dir.c_str(),
-              out_dir.c_str());
+  // Issue 10's targets, per material and method.
+  std::string table =
+      "| material | method | shapes | failed starts | <= 1% and >= 3x | >= 2x | median error | median time | max time |\n"
+      "|---|---|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const std::string& material : material_specs)
+    for (const auto method : methods) {
+      std::vector<const Run*> group;
+      for (const Run& run : runs)
+        if (run.material == material && run.result.method == method) group.push_back(&run);
+      if (!group.empty()) table += target_summary(material, balloon::design_method_name(method), group);
+    }
+  std::printf("\ntargets (issue 10): no failed start; <= 1%% and >= 3x on >= 90%% of shapes; >= 2x on all; median <= 0.7%%\n%s",
+              table.c_str());
+  std::ofstream(out_dir + "/design_table.md") << table;
+  std::printf("curves: %s/<shape>_<method>_convergence.csv, plots: %s/<shape>_error_vs_time.svg, table: %s/design_table.md\n",
+              out_dir.c_str(), out_dir.c_str(), out_dir.c_str());
   return 0;
 }
