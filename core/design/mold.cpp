@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "design/nozzle.hpp"
-#include "design/self_intersection.hpp"
+#include "mesh/self_intersection.hpp"
 #include "mesh/mesh_checks.hpp"
 #include "mesh/mesh_geometry.hpp"
 

@@ -4,8 +4,10 @@
 #include <chrono>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 #include "fem/balloon_model.hpp"
+#include "mesh/self_intersection.hpp"
 #include "solve/equilibrium_solver.hpp"
 #include "solve/rigid_modes.hpp"
 
@@ -346,6 +348,18 @@ std::string options_problem(const TriMesh& rest, const InflationOptions& options
   return "";
 }
 
+/// The deformed surface intersects itself while the rest surface does not (a rest mesh that already
+/// does says nothing about the inflation). A mesh CGAL cannot take is not judged.
+bool passes_through_itself(const TriMesh& rest, const Positions& deformed) {
+  try {
+    TriMesh inflated = rest;
+    inflated.vertices = deformed;
+    return mesh_self_intersects(inflated) && !mesh_self_intersects(rest);
+  } catch (const std::invalid_argument&) {
+    return false;
+  }
+}
+
 }  // namespace
 
 const char* inflation_stop_word(InflationStop stop) {
@@ -354,6 +368,7 @@ const char* inflation_stop_word(InflationStop stop) {
     case InflationStop::InvalidInput: return "invalid_input";
     case InflationStop::AboveMaximumPressure: return "above_max_pressure";
     case InflationStop::NoEquilibrium: return "no_equilibrium";
+    case InflationStop::PassesThroughItself: return "passes_through_itself";
     case InflationStop::Cancelled: return "cancelled";
     case InflationStop::TimeLimit: return "time_limit";
   }
@@ -369,7 +384,15 @@ InflationResult inflate(const TriMesh& rest, const InflationOptions& options, co
     return result;
   }
   InflationRun run(rest, options);
-  return run.run(initial_guess);
+  InflationResult result = run.run(initial_guess);
+  if (result.converged && options.reject_self_intersection && passes_through_itself(rest, result.deformed)) {
+    result.converged = false;
+    result.stop = InflationStop::PassesThroughItself;
+    result.message = "no equilibrium: the membrane's equilibrium at volume ratio " + format_number(result.volume_ratio) +
+                     " (" + format_kpa(result.pressure_kpa * MPA_PER_KPA) +
+                     ") passes through itself; its walls touch on the way there, and this model has no contact";
+  }
+  return result;
 }
 
 }  // namespace balloon

@@ -29,6 +29,10 @@ struct InflationOptions {
   /// on bench_robustness it cures some shapes and slows others, because slack regions are mechanisms
   /// (zero stiffness) near zero pressure (README, "Robustness").
   bool tension_field = false;
+  /// A converged shape whose surface passes through itself (while the rest surface does not) is no
+  /// physical equilibrium: the walls would touch first, and this model has no contact. Reported as
+  /// InflationStop::PassesThroughItself. Costs two CGAL self-intersection tests (~10 ms per 10k faces).
+  bool reject_self_intersection = true;
   ProgressCallback progress;                 ///< optional
   const CancelToken* cancel = nullptr;       ///< optional
 };
@@ -39,6 +43,7 @@ enum class InflationStop {
   InvalidInput,          ///< the options or the rest mesh were rejected before any work
   AboveMaximumPressure,  ///< pressure control asked for more than the balloon's pressure maximum
   NoEquilibrium,         ///< the load path could not be continued (the message says where and why)
+  PassesThroughItself,   ///< the equilibrium found would pass through itself: the walls touch before it
   Cancelled,
   TimeLimit,
 };

@@ -44,6 +44,7 @@ v1::SimulateReport simulate_report(const jobs::SimulateInput& input, const Infla
   }
   report.set_flipped_orientation(input.flipped_orientation);
   report.set_message(result.message);
+  report.set_stop_reason(inflation_stop_word(result.stop));
   return report;
 }
 

@@ -56,6 +56,7 @@ TEST_F(SimulateCommand, JsonHasTheContractKeysAndReachesTheVolumeRatio) {
                           "load_steps", "message", "material", "thickness_mm", "flipped_orientation", "unstable_modes"})
     EXPECT_TRUE(json_field(json, key).has_value()) << "missing key " << key;
   EXPECT_EQ(json_field(json, "converged"), "true");
+  EXPECT_EQ(json_field(json, "stop_reason"), "\"converged\"");
   EXPECT_GE(json_number_field(json, "unstable_modes"), 0);
   EXPECT_EQ(json_number_field(json, "vertices"), 642);
   EXPECT_NEAR(json_number_field(json, "volume_ratio"), 8.0, 1e-6);
@@ -103,6 +104,7 @@ TEST_F(SimulateCommand, NotConvergedPrintsTheResultExitsThreeAndWritesNoFile) {
       run({"simulate", sphere(), "--material", "neo-hookean:mu=0.3", "--pressure", "20", "--out", out, "--json"});
   EXPECT_EQ(result.exit_code, 3) << result.err;
   EXPECT_EQ(json_field(result.out, "converged"), "false") << result.out;
+  EXPECT_EQ(json_field(result.out, "stop_reason"), "\"above_max_pressure\"") << result.out;
   EXPECT_TRUE(json_field(result.out, "residual_norm").has_value());
   EXPECT_FALSE(std::filesystem::exists(out));
 }

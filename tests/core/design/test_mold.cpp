@@ -1,5 +1,5 @@
 #include "design/mold.hpp"
-#include "design/self_intersection.hpp"
+#include "mesh/self_intersection.hpp"
 #include "design/target_preparation.hpp"
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
-// Includes CGAL (with surface_distance.cpp and target_preparation.cpp): keep this file this small.
-#include "design/self_intersection.hpp"
+// Includes CGAL (the only file of core/mesh that does): keep this file this small.
+#include "mesh/self_intersection.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>

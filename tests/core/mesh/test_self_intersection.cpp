@@ -1,4 +1,4 @@
-#include "design/self_intersection.hpp"
+#include "mesh/self_intersection.hpp"
 
 #include <gtest/gtest.h>
 
