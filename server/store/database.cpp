@@ -11,7 +11,7 @@ namespace {
 
 }  // namespace
 
-Database::Database(const std::string& path, int busy_timeout_ms) : m_path(path) {
+Database::Database(const std::string& path, int busy_timeout_ms, Synchronous synchronous) : m_path(path) {
   const int flags = SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX;
   if (sqlite3_open_v2(path.c_str(), &m_db, flags, nullptr) != SQLITE_OK) {
     const std::string message = m_db != nullptr ? sqlite3_errmsg(m_db) : "out of memory";
@@ -21,10 +21,11 @@ Database::Database(const std::string& path, int busy_timeout_ms) : m_path(path) 
   }
   sqlite3_extended_result_codes(m_db, 1);
   sqlite3_busy_timeout(m_db, busy_timeout_ms);
-  // WAL lets readers proceed during a write; synchronous=FULL makes every commit durable across power
-  // loss, which is what "a job is in the database before SubmitJob returns" needs.
+  // WAL lets readers proceed during a write. synchronous=FULL makes every commit durable across power
+  // loss; NORMAL leaves the flush to the owner (Store::sync), so it need not happen under a lock.
   if (path != ":memory:") execute("PRAGMA journal_mode = WAL");
-  execute("PRAGMA synchronous = FULL; PRAGMA foreign_keys = ON");
+  execute(synchronous == Synchronous::Full ? "PRAGMA synchronous = FULL; PRAGMA foreign_keys = ON"
+                                           : "PRAGMA synchronous = NORMAL; PRAGMA foreign_keys = ON");
 }
 
 Database::~Database() {
