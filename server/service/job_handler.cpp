@@ -30,6 +30,7 @@ constexpr double SHAPE_CHECKPOINT_INTERVAL_S = 1.0;  // stored shapes are big: a
 constexpr double PROGRESS_BATCH_INTERVAL_S = 1.0;
 constexpr int FAIL_WRITE_ATTEMPTS = 3;
 constexpr std::size_t MAX_REQUEST_ID_LENGTH = 128;
+constexpr std::size_t MAX_PREPARED = 4;  // decoded jobs kept from submit to run (a few meshes in memory)
 constexpr std::chrono::hours RETENTION_INTERVAL{1};  // how often old finished jobs are deleted
 constexpr std::int64_t REQUEST_ID_WINDOW_MS = 24LL * 3600 * 1000;  // a repeat within 24 h returns the first job
 
@@ -253,6 +254,11 @@ ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobReques
       throw;
     }
   }
+  if (checked.prepared) {
+    std::lock_guard lock(m_prepared_mutex);
+    m_prepared[record.row_id] = std::move(checked.prepared);
+    if (m_prepared.size() > MAX_PREPARED) m_prepared.erase(m_prepared.begin());
+  }
   m_queue.push_reserved(record.row_id, record.owner, record.priority);
   log("job " + record.job_id + " submitted by " + caller.tenant + ": " + record.summary);
   fill_job(record, reply->mutable_job());
@@ -415,10 +421,18 @@ ServiceStatus JobHandler::result(const Caller& caller, const v1::GetResultReques
   const auto stored = m_jobs.result(record->row_id);
   if (!stored) return ServiceStatus::error(StatusCode::Internal, "job " + record->job_id + " has lost its result");
   reply->set_job_id(record->job_id);
-  return kind->fill_result(*stored, format, reply);
+  return kind->fill_result(*stored, format, reply, request.inflated_mesh_only());
 }
 
 void JobHandler::run_job(std::int64_t row_id) {
+  std::shared_ptr<const void> prepared;
+  {
+    std::lock_guard lock(m_prepared_mutex);
+    if (const auto it = m_prepared.find(row_id); it != m_prepared.end()) {
+      prepared = std::move(it->second);
+      m_prepared.erase(it);
+    }
+  }
   std::optional<store::JobRecord> record = m_jobs.find_row(row_id);
   if (!record || record->state != JobState::Queued) return;
   if (!m_jobs.mark_running(row_id)) return;  // cancelled between pop and start
@@ -441,7 +455,7 @@ void JobHandler::run_job(std::int64_t row_id) {
       std::function<void()> flush_progress;
       RunContext context{*record, spec, active->token, progress_publisher(*record, spec, &flush_progress),
                          [this, &record](const Faces& faces) { m_watches.set_connectivity(record->job_id, faces); },
-                         m_materials, m_jobs.design_checkpoint(record->row_id)};
+                         m_materials, m_jobs.design_checkpoint(record->row_id), std::move(prepared)};
       RunOutcome outcome = kind->run(context);
       flush_progress();  // the last rows before the outcome, so a finished job has all of them
       finish_run(*record, *kind, *active, std::move(outcome));

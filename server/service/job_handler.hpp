@@ -109,6 +109,11 @@ class JobHandler {
   bool m_started = false;
   int m_lock_fd = -1;
 
+  /// Jobs checked at submit in this process, ready to run (CheckedJob::prepared), by row id: the run
+  /// neither parses nor checks them again. At most MAX_PREPARED are kept (the oldest go first).
+  std::mutex m_prepared_mutex;
+  std::map<std::int64_t, std::shared_ptr<const void>> m_prepared;
+
   std::mutex m_request_mutex;  // held from the request_id lookup to the insert
   std::mutex m_id_mutex;
   std::uint64_t m_id_state = 0;

@@ -51,6 +51,10 @@ Statement Database::prepare(std::string_view sql) {
   return Statement(*this, statement);
 }
 
+void Database::keep_wal_on_close() {
+  sqlite3_db_config(m_db, SQLITE_DBCONFIG_NO_CKPT_ON_CLOSE, 1, nullptr);
+}
+
 std::int64_t Database::last_insert_id() const { return sqlite3_last_insert_rowid(m_db); }
 int Database::changes() const { return sqlite3_changes(m_db); }
 

@@ -45,6 +45,8 @@ class Database {
   std::int64_t last_insert_id() const;
   /// Rows changed by the last INSERT, UPDATE or DELETE.
   int changes() const;
+  /// Leaves the WAL as it is when this connection, the last one, closes (no checkpoint, no fsync at close).
+  void keep_wal_on_close();
   /// The path it was opened with.
   const std::string& path() const { return m_path; }
 

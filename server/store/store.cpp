@@ -39,6 +39,15 @@ Store::Store(const std::string& path, StoreOptions options)
     return;
   }
   m_checkpoint_database = std::make_unique<Database>(path, 5000, Synchronous::Normal);
+  if (!m_options.durable) {
+    // A short-lived command: closing must not checkpoint (fsyncs at every exit, and a new WAL whose
+    // header and folder are synced at the next start). The WAL is read back at the next open instead,
+    // and the checkpointer copies it once it has grown.
+    m_database.keep_wal_on_close();
+    m_checkpoint_database->keep_wal_on_close();
+    struct stat info {};
+    m_checkpoint_due = ::fstat(m_wal_fd, &info) == 0 && info.st_size >= CHECKPOINT_WAL_BYTES;
+  }
   m_checkpointer = std::thread([this] { checkpoint_loop(); });
 }
 
