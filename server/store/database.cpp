@@ -26,6 +26,8 @@ Database::Database(const std::string& path, int busy_timeout_ms, Synchronous syn
   if (path != ":memory:") execute("PRAGMA journal_mode = WAL");
   execute(synchronous == Synchronous::Full ? "PRAGMA synchronous = FULL; PRAGMA foreign_keys = ON"
                                            : "PRAGMA synchronous = NORMAL; PRAGMA foreign_keys = ON");
+  // Statement journals and sorts in memory: a result's multi-MB blobs must not be copied to /var/tmp.
+  execute("PRAGMA temp_store = MEMORY");
 }
 
 Database::~Database() {
@@ -50,6 +52,8 @@ Statement Database::prepare(std::string_view sql) {
     throw_error(m_db, "preparing '" + std::string(sql.substr(0, 60)) + "'");
   return Statement(*this, statement);
 }
+
+void Database::interrupt() { sqlite3_interrupt(m_db); }
 
 void Database::keep_wal_on_close() {
   sqlite3_db_config(m_db, SQLITE_DBCONFIG_NO_CKPT_ON_CLOSE, 1, nullptr);

@@ -47,6 +47,8 @@ class Database {
   int changes() const;
   /// Leaves the WAL as it is when this connection, the last one, closes (no checkpoint, no fsync at close).
   void keep_wal_on_close();
+  /// Makes a statement running on this connection (from another thread) stop soon with an error.
+  void interrupt();
   /// The path it was opened with.
   const std::string& path() const { return m_path; }
 

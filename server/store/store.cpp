@@ -41,8 +41,8 @@ Store::Store(const std::string& path, StoreOptions options)
   m_checkpoint_database = std::make_unique<Database>(path, 5000, Synchronous::Normal);
   if (!m_options.durable) {
     // A short-lived command: closing must not checkpoint (fsyncs at every exit, and a new WAL whose
-    // header and folder are synced at the next start). The WAL is read back at the next open instead,
-    // and the checkpointer copies it once it has grown.
+    // header and folder are synced at the next start). The WAL is read back at the next open instead;
+    // once it has grown, the checkpointer copies it in the background of a later command.
     m_database.keep_wal_on_close();
     m_checkpoint_database->keep_wal_on_close();
     struct stat info {};
@@ -57,14 +57,18 @@ Store::~Store() {
     m_stopping = true;
   }
   m_checkpoint_wake.notify_all();
+  // A checkpoint under way stops where it is (what it copied stays copied): closing does not wait for it.
+  if (m_checkpoint_database) m_checkpoint_database->interrupt();
   if (m_checkpointer.joinable()) m_checkpointer.join();
   m_checkpoint_database.reset();
   if (m_wal_fd >= 0) ::close(m_wal_fd);
 }
 
 void Store::sync() {
-  if (m_wal_fd < 0) return;
-  if (m_options.durable) ::fdatasync(m_wal_fd);
+  // Not durable (a command's store): no flush, and no checkpoint during the command either (its fsyncs
+  // would compete with the work); what the WAL holds is copied when a later command opens the store.
+  if (m_wal_fd < 0 || !m_options.durable) return;
+  ::fdatasync(m_wal_fd);
   struct stat info {};
   if (::fstat(m_wal_fd, &info) == 0 && info.st_size >= CHECKPOINT_WAL_BYTES) {
     {
@@ -80,6 +84,7 @@ void Store::checkpoint_loop() {
   while (!m_stopping) {
     m_checkpoint_wake.wait_for(lock, CHECKPOINT_PERIOD, [this] { return m_stopping || m_checkpoint_due; });
     if (m_stopping) break;
+    if (!m_checkpoint_due && !m_options.durable) continue;  // a command's store: only what open found
     m_checkpoint_due = false;
     struct stat info {};
     if (::fstat(m_wal_fd, &info) != 0 || info.st_size == 0) continue;
