@@ -5,6 +5,7 @@
 // with their own store: wall time against the solver's own time_s, and the process's peak memory.
 // Usage: bench_inflation [DATA_DIR] [--quick] [--cli PATH_TO_BALLOON | --no-cli]
 #include <fcntl.h>
+#include <malloc.h>
 #include <spawn.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -32,8 +33,10 @@
 
 namespace {
 
-/// Resets the process's peak resident set (Linux: writing 5 to clear_refs), so each row reports its own.
+/// Resets the process's peak resident set (Linux: writing 5 to clear_refs), so each row reports its own;
+/// memory the allocator still holds from earlier rows is given back first (else it would count again).
 void reset_peak_memory() {
+  malloc_trim(0);
   std::ofstream clear("/proc/self/clear_refs");
   clear << "5";
 }
