@@ -68,7 +68,24 @@ void Store::sync() {
   // Not durable (a command's store): no flush, and no checkpoint during the command either (its fsyncs
   // would compete with the work); what the WAL holds is copied when a later command opens the store.
   if (m_wal_fd < 0 || !m_options.durable) return;
-  ::fdatasync(m_wal_fd);
+  {
+    std::unique_lock lock(m_sync_mutex);
+    const std::uint64_t mine = ++m_sync_requested;
+    while (m_sync_covered < mine) {
+      if (m_syncing) {
+        m_sync_done.wait(lock);  // the flush under way may have started before this commit: wait for it
+        continue;
+      }
+      m_syncing = true;  // lead the next flush: it covers every caller so far
+      const std::uint64_t covers = m_sync_requested;
+      lock.unlock();
+      ::fdatasync(m_wal_fd);
+      lock.lock();
+      m_sync_covered = covers;
+      m_syncing = false;
+      m_sync_done.notify_all();
+    }
+  }
   struct stat info {};
   if (::fstat(m_wal_fd, &info) == 0 && info.st_size >= CHECKPOINT_WAL_BYTES) {
     {

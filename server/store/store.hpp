@@ -10,6 +10,7 @@
 /// database, with their own fsyncs) run on a second connection on a background thread, never under the
 /// mutex. Progress rows and design checkpoints are not synced: a power loss may lose the last of them.
 #include <condition_variable>
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -69,6 +70,14 @@ class Store {
   Database m_database;
   std::mutex m_mutex;
   int m_wal_fd = -1;  ///< the WAL file, for fdatasync (-1: in memory)
+
+  // Group commit: one fdatasync covers every commit made before it started, so callers that arrive while
+  // one runs share the next instead of queueing one each.
+  std::mutex m_sync_mutex;
+  std::condition_variable m_sync_done;
+  std::uint64_t m_sync_requested = 0;  ///< callers so far (each after its commit)
+  std::uint64_t m_sync_covered = 0;    ///< callers whose commits the last finished fdatasync covered
+  bool m_syncing = false;
 
   std::unique_ptr<Database> m_checkpoint_database;  ///< the checkpointer's own connection
   std::thread m_checkpointer;
