@@ -558,6 +558,7 @@ ProgressCallback JobHandler::progress_publisher(const store::JobRecord& record, 
         positions->Set(static_cast<int>(i), static_cast<float>(progress.shape->data()[i]));
     }
     const auto now = std::chrono::steady_clock::now();
+    bool recorded = false;  // this event's row is among the pending ones
     if (std::chrono::duration<double>(now - state->last_checkpoint).count() >= m_options.checkpoint_interval_s) {
       if (progress.shape != nullptr &&
           std::chrono::duration<double>(now - state->last_shape_checkpoint).count() >= SHAPE_CHECKPOINT_INTERVAL_S) {
@@ -567,6 +568,7 @@ ProgressCallback JobHandler::progress_publisher(const store::JobRecord& record, 
       }
       state->pending.push_back(checkpoint);
       state->last_checkpoint = now;
+      recorded = true;
     }
     if (!state->pending.empty() &&
         std::chrono::duration<double>(now - state->last_flush).count() >= PROGRESS_BATCH_INTERVAL_S) {
@@ -576,6 +578,10 @@ ProgressCallback JobHandler::progress_publisher(const store::JobRecord& record, 
     // A design's rest shape is what a restarted run continues from (issue 12): one kept per job.
     if (progress.rest_shape != nullptr && progress.iteration > 0 &&
         std::chrono::duration<double>(now - state->last_rest_checkpoint).count() >= SHAPE_CHECKPOINT_INTERVAL_S) {
+      // The stored progress never lags the resume point: this event's row goes in first.
+      if (!recorded) state->pending.push_back(checkpoint);
+      write_pending(*state);
+      state->last_flush = now;
       m_jobs.save_design_checkpoint(row_id, progress.iteration,
                                     store::encode_mesh_blob(TriMesh{*progress.rest_shape, Faces(0, 3)}));
       state->last_rest_checkpoint = now;
