@@ -76,7 +76,7 @@ WatchOutcome watch_job(ServiceConnection& connection, const std::string& job_id,
   std::thread monitor([&] {
     while (!done.load()) {
       if (interrupts.count() > 0) {
-        context.TryCancel();
+        connection.try_cancel(context);
         return;
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(20));

@@ -11,10 +11,11 @@ namespace balloon::cli {
 namespace v1 = balloon::v1;
 
 Result<v1::JobResult> fetch_result(ServiceConnection& connection, const std::string& job_id, v1::MeshFormat format,
-                                   grpc::Status* status) {
+                                   grpc::Status* status, bool inflated_mesh_only) {
   v1::GetResultRequest request;
   request.set_job_id(job_id);
   request.set_format(format);
+  request.set_inflated_mesh_only(inflated_mesh_only);
   v1::JobResult result;
   grpc::ClientContext context;
   connection.prepare(context);

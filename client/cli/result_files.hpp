@@ -11,9 +11,11 @@
 
 namespace balloon::cli {
 
-/// GetResult of `job_id` with meshes in `format`; the error carries the status (for exit_code_for).
+/// GetResult of `job_id` with meshes in `format` (only the inflated one with `inflated_mesh_only`); the
+/// error carries the status (for exit_code_for).
 Result<balloon::v1::JobResult> fetch_result(ServiceConnection& connection, const std::string& job_id,
-                                            balloon::v1::MeshFormat format, grpc::Status* status);
+                                            balloon::v1::MeshFormat format, grpc::Status* status,
+                                            bool inflated_mesh_only = false);
 
 /// Writes `result`'s files (contract::job_result_files) into `out_dir` (which exists):
 ///   design:        rest.EXT, inflated.EXT, mold.stl, report.json, convergence.csv

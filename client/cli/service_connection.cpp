@@ -15,7 +15,8 @@
 namespace balloon::cli {
 
 ServiceConnection::~ServiceConnection() {
-  m_stub.reset();
+  m_stub = nullptr;
+  m_remote_stub.reset();
   m_channel.reset();
   if (m_embedded) m_embedded->shutdown(2.0);
 }
@@ -39,6 +40,8 @@ Result<std::unique_ptr<ServiceConnection>> ServiceConnection::open(const Connect
     arguments.SetMaxReceiveMessageSize(-1);
     connection->m_channel = grpc::CreateCustomChannel(options.server, credentials, arguments);
     connection->m_token = options.token;
+    connection->m_remote_stub = balloon::v1::BalloonService::NewStub(connection->m_channel);
+    connection->m_stub = connection->m_remote_stub.get();
   } else {
     embedded::EmbeddedOptions embedded_options;
     embedded_options.db_path = options.db.empty() ? embedded::default_database_path() : options.db;
@@ -52,11 +55,15 @@ Result<std::unique_ptr<ServiceConnection>> ServiceConnection::open(const Connect
     }
     if (!server) return fail("cannot start the embedded server: " + server.error());
     connection->m_embedded = std::move(*server);
-    connection->m_channel = connection->m_embedded->channel();
+    connection->m_stub = &connection->m_embedded->stub();
     connection->m_database = embedded_options.db_path;
   }
-  connection->m_stub = balloon::v1::BalloonService::NewStub(connection->m_channel);
   return connection;
+}
+
+void ServiceConnection::try_cancel(grpc::ClientContext& context) {
+  context.TryCancel();
+  if (m_embedded) m_embedded->cancel(&context);
 }
 
 void ServiceConnection::prepare(grpc::ClientContext& context) const {
@@ -78,11 +85,9 @@ std::string new_request_id() {
 
 }  // namespace
 
-grpc::Status ServiceConnection::submit(const balloon::v1::SubmitJobRequest& request,
-                                       balloon::v1::SubmitJobResponse* reply) {
+grpc::Status ServiceConnection::submit(balloon::v1::SubmitJobRequest& sent, balloon::v1::SubmitJobResponse* reply) {
   // One request id per submission, reused by its retries: a reply lost on the way back must not leave
   // a second job behind (the server returns the first job for a repeated id).
-  balloon::v1::SubmitJobRequest sent = request;
   if (sent.request_id().empty()) sent.set_request_id(new_request_id());
   grpc::Status status;
   for (int attempt = 1; attempt <= SUBMIT_TRIES; ++attempt) {

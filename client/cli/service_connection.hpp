@@ -1,7 +1,7 @@
 #pragma once
 /// How the CLI reaches the service: a remote server (--server / BALLOON_SERVER, with --token /
 /// BALLOON_TOKEN) or, by default, an embedded in-process server on a local SQLite file (same service
-/// code, no port).
+/// code, called in-process through the same stub interface: no port, no gRPC server).
 #include <memory>
 #include <string>
 #include <vector>
@@ -32,11 +32,14 @@ class ServiceConnection {
   static Result<std::unique_ptr<ServiceConnection>> open(const ConnectionOptions& options);
   ~ServiceConnection();
 
-  balloon::v1::BalloonService::Stub& stub() { return *m_stub; }
+  balloon::v1::BalloonService::StubInterface& stub() { return *m_stub; }
+  /// Cancels the call (or WatchJob stream) made with `context`, remote or in-process.
+  void try_cancel(grpc::ClientContext& context);
   /// Adds the token to a call's metadata.
   void prepare(grpc::ClientContext& context) const;
-  /// SubmitJob with the token: returns once the job is stored and queued.
-  grpc::Status submit(const balloon::v1::SubmitJobRequest& request, balloon::v1::SubmitJobResponse* reply);
+  /// SubmitJob with the token: returns once the job is stored and queued. Gives `request` a request id
+  /// if it has none (in place: an uploaded mesh is not copied).
+  grpc::Status submit(balloon::v1::SubmitJobRequest& request, balloon::v1::SubmitJobResponse* reply);
   /// True for the embedded server.
   bool embedded() const { return m_embedded != nullptr; }
   /// Where the embedded server keeps its data (empty for a remote server).
@@ -45,8 +48,9 @@ class ServiceConnection {
  private:
   ServiceConnection() = default;
   std::unique_ptr<embedded::EmbeddedServer> m_embedded;
-  std::shared_ptr<grpc::Channel> m_channel;
-  std::unique_ptr<balloon::v1::BalloonService::Stub> m_stub;
+  std::shared_ptr<grpc::Channel> m_channel;                              // remote only
+  std::unique_ptr<balloon::v1::BalloonService::StubInterface> m_remote_stub;  // remote only
+  balloon::v1::BalloonService::StubInterface* m_stub = nullptr;
   std::string m_token;
   std::string m_database;
 };

@@ -102,7 +102,8 @@ int finish_simulate(ServiceConnection& connection, const PreparedJob& job, const
   const std::optional<std::string> out_path = job.args.get("out");
   grpc::Status status;
   Result<v1::JobResult> result =
-      fetch_result(connection, job_id, out_path ? mesh_format_from_path(*out_path) : v1::MESH_FORMAT_OBJ, &status);
+      fetch_result(connection, job_id, out_path ? mesh_format_from_path(*out_path) : v1::MESH_FORMAT_OBJ, &status,
+                   true);  // --out is the inflated mesh; the rest mesh is the user's own file
   if (!result) return report_error(COMMAND, result.error(), exit_code_for(status));
 
   if (global.json)

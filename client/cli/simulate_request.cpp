@@ -74,9 +74,13 @@ Result<balloon::v1::SubmitJobRequest> simulate_request_from_args(const ParsedArg
     return fail("cannot read mesh '" + mesh_path + "': unknown extension (obj, stl, ply, off, gltf, glb)");
   std::ifstream in(mesh_path, std::ios::binary);
   if (!in) return fail("cannot read mesh '" + mesh_path + "'");
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  job->mutable_rest_mesh()->set_data(bytes.str());
+  // Straight into the request (a 100k-vertex OBJ is 7.5 MB: no intermediate copies).
+  std::string* data = job->mutable_rest_mesh()->mutable_data();
+  const std::uintmax_t size = std::filesystem::file_size(mesh_path, error);
+  if (error) return fail("cannot read mesh '" + mesh_path + "'");
+  data->resize(static_cast<std::size_t>(size));
+  if (!in.read(data->data(), static_cast<std::streamsize>(size)) || in.peek() != std::char_traits<char>::eof())
+    return fail("cannot read mesh '" + mesh_path + "' (it changed while being read)");
   job->mutable_rest_mesh()->set_format(format);
   return request;
 }

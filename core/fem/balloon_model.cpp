@@ -19,7 +19,9 @@ void BalloonModel::set_rest_positions(const Positions& rest) {
   m_rest = rest;
   m_rest_triangles.resize(static_cast<size_t>(m_faces.rows()));
   m_rest_area = 0.0;
-  const Eigen::Map<const Eigen::VectorXd> x(m_rest.data(), m_rest.size());
+  // One flat copy: corners() takes a VectorXd, and a Map passed to it would be copied whole for every face
+  // (quadratic: 11 s at 100k vertices).
+  const Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(m_rest.data(), m_rest.size());
   for (int f = 0; f < m_faces.rows(); ++f) {
     m_rest_triangles[static_cast<size_t>(f)] = make_rest_triangle(corners(x, f));
     m_rest_area += m_rest_triangles[static_cast<size_t>(f)].area;

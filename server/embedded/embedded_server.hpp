@@ -1,17 +1,15 @@
 #pragma once
-/// The in-process service the CLI uses when no --server is given: the same store, queue, workers and gRPC
-/// service as balloon-server, on a local SQLite file, reached through a channel with no port. The CLI
-/// sees only this class and the generated stub, never the service's internals.
+/// The in-process service the CLI uses when no --server is given: the same store, queue, workers and
+/// handlers as balloon-server, on a local SQLite file, reached through the generated stub interface
+/// implemented in-process (rpc/direct_stub: no gRPC server, no port, no serialization). The CLI sees only
+/// this class and the stub interface, never the service's internals.
 #include <memory>
 #include <string>
 
-#include <grpcpp/channel.h>
+#include <grpcpp/client_context.h>
 
+#include "balloon/v1/balloon.grpc.pb.h"
 #include "result.hpp"
-
-namespace balloon::rpc {
-class GrpcServer;
-}
 
 namespace balloon::embedded {
 
@@ -21,21 +19,25 @@ struct EmbeddedOptions {
 };
 
 /// One user's service on this machine: no tenant quotas and no retention (their history is never deleted
-/// behind their back), workers on every core.
+/// behind their back), workers on every core, commits not flushed to disk (a crash of the process loses
+/// nothing; a crash of the machine may lose the last jobs).
 class EmbeddedServer {
  public:
   /// Opens the store, recovers its unfinished jobs and starts the workers. Errors name the problem.
   static Result<std::unique_ptr<EmbeddedServer>> start(const EmbeddedOptions& options);
   ~EmbeddedServer();
 
-  /// A channel to the service that bypasses the network.
-  std::shared_ptr<grpc::Channel> channel();
+  /// The service's API, called in this process (synchronous calls only).
+  balloon::v1::BalloonService::StubInterface& stub();
+  /// Ends a WatchJob stream opened with `context` (ClientContext::TryCancel does not reach it).
+  void cancel(grpc::ClientContext* context);
   /// Stops the workers (running jobs stay queued in the store), waiting at most `grace_s`. Idempotent.
   void shutdown(double grace_s);
 
  private:
-  explicit EmbeddedServer(std::unique_ptr<rpc::GrpcServer> server);
-  std::unique_ptr<rpc::GrpcServer> m_server;
+  struct Internals;
+  explicit EmbeddedServer(std::unique_ptr<Internals> internals);
+  std::unique_ptr<Internals> m_internals;
 };
 
 /// The embedded server's default database: $XDG_DATA_HOME/balloon/balloon.db, else

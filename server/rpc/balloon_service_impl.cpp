@@ -148,18 +148,7 @@ grpc::Status BalloonServiceImpl::call(const char* method, grpc::ServerContextBas
                                       Reply* reply, Handler&& handler) {
   service::Caller caller;
   if (grpc::Status status = authenticate(context, &caller); !status.ok()) return status;
-  // Every call on one job (get, cancel, result, ...) first checks that the id is this shard's.
-  if constexpr (requires { request->job_id(); }) {
-    if (const service::ServiceStatus shard = service::check_job_shard(m_shard_name, request->job_id()); !shard.ok())
-      return to_grpc_status(shard);
-  }
-  try {
-    return to_grpc_status(handler(caller, *request, reply));
-  } catch (const std::exception& error) {
-    // No exception escapes a handler: log the detail, tell the client only that it was ours.
-    if (m_log) m_log(std::string(method) + ": internal error: " + error.what());
-    return grpc::Status(grpc::StatusCode::INTERNAL, std::string("internal error in ") + method);
-  }
+  return dispatch(method, caller, m_shard_name, m_log, *request, reply, std::forward<Handler>(handler));
 }
 
 grpc::Status BalloonServiceImpl::SubmitJob(grpc::ServerContext* context, const v1::SubmitJobRequest* request,

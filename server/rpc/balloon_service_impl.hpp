@@ -7,6 +7,7 @@
 #include <string>
 
 #include "balloon/v1/balloon.grpc.pb.h"
+#include "rpc/dispatch.hpp"
 #include "service/job_handler.hpp"
 #include "service/material_handler.hpp"
 #include "service/token_table.hpp"
@@ -60,8 +61,5 @@ class BalloonServiceImpl final : public BalloonServiceBase {
   std::string m_shard_name;
 };
 
-/// A handler status as a grpc::Status (same code, same message; its field violations, if any, as a
-/// google.rpc.Status holding a google.rpc.BadRequest in the error details).
-grpc::Status to_grpc_status(const service::ServiceStatus& status);
 
 }  // namespace balloon::rpc

@@ -74,7 +74,7 @@ Result<std::unique_ptr<GrpcServer>> GrpcServer::start(const ServerConfig& config
   }
 
   try {
-    internals->store = std::make_unique<store::Store>(config.service.db_path);
+    internals->store = std::make_unique<store::Store>(config.service.db_path, store::StoreOptions{config.service.durable_store});
   } catch (const std::exception& error) {
     return fail(error.what());
   }

@@ -107,7 +107,8 @@ class FitMaterialKind final : public JobKind {
   }
 
   // A fit has no meshes: the report is the whole result.
-  ServiceStatus fill_result(const store::ResultRecord& stored, v1::MeshFormat, v1::JobResult* reply) const override {
+  ServiceStatus fill_result(const store::ResultRecord& stored, v1::MeshFormat, v1::JobResult* reply,
+                            bool) const override {
     reply->set_kind(proto_kind());
     reply->set_converged(stored.converged);
     return fill_report(stored, reply);

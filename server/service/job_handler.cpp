@@ -25,8 +25,12 @@ using store::JobState;
 constexpr int MAX_PAGE_SIZE = 1000;
 constexpr int DEFAULT_PAGE_SIZE = 100;
 constexpr double SHAPE_CHECKPOINT_INTERVAL_S = 1.0;  // stored shapes are big: at most one a second per job
+// Progress rows go to the store in one transaction per this interval per job (the first at once, the
+// rest when the run ends): a crash loses at most the rows of the last interval, never a result.
+constexpr double PROGRESS_BATCH_INTERVAL_S = 1.0;
 constexpr int FAIL_WRITE_ATTEMPTS = 3;
 constexpr std::size_t MAX_REQUEST_ID_LENGTH = 128;
+constexpr std::size_t MAX_PREPARED = 4;  // decoded jobs kept from submit to run (a few meshes in memory)
 constexpr std::chrono::hours RETENTION_INTERVAL{1};  // how often old finished jobs are deleted
 constexpr std::int64_t REQUEST_ID_WINDOW_MS = 24LL * 3600 * 1000;  // a repeat within 24 h returns the first job
 
@@ -250,6 +254,11 @@ ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobReques
       throw;
     }
   }
+  if (checked.prepared) {
+    std::lock_guard lock(m_prepared_mutex);
+    m_prepared[record.row_id] = std::move(checked.prepared);
+    if (m_prepared.size() > MAX_PREPARED) m_prepared.erase(m_prepared.begin());
+  }
   m_queue.push_reserved(record.row_id, record.owner, record.priority);
   log("job " + record.job_id + " submitted by " + caller.tenant + ": " + record.summary);
   fill_job(record, reply->mutable_job());
@@ -412,10 +421,18 @@ ServiceStatus JobHandler::result(const Caller& caller, const v1::GetResultReques
   const auto stored = m_jobs.result(record->row_id);
   if (!stored) return ServiceStatus::error(StatusCode::Internal, "job " + record->job_id + " has lost its result");
   reply->set_job_id(record->job_id);
-  return kind->fill_result(*stored, format, reply);
+  return kind->fill_result(*stored, format, reply, request.inflated_mesh_only());
 }
 
 void JobHandler::run_job(std::int64_t row_id) {
+  std::shared_ptr<const void> prepared;
+  {
+    std::lock_guard lock(m_prepared_mutex);
+    if (const auto it = m_prepared.find(row_id); it != m_prepared.end()) {
+      prepared = std::move(it->second);
+      m_prepared.erase(it);
+    }
+  }
   std::optional<store::JobRecord> record = m_jobs.find_row(row_id);
   if (!record || record->state != JobState::Queued) return;
   if (!m_jobs.mark_running(row_id)) return;  // cancelled between pop and start
@@ -435,10 +452,13 @@ void JobHandler::run_job(std::int64_t row_id) {
     if (kind == nullptr) {
       fail_job(*record, spec_ok ? "this server cannot run this kind of job" : "the stored job spec is unreadable");
     } else {
-      RunContext context{*record, spec, active->token, progress_publisher(*record, spec),
+      std::function<void()> flush_progress;
+      RunContext context{*record, spec, active->token, progress_publisher(*record, spec, &flush_progress),
                          [this, &record](const Faces& faces) { m_watches.set_connectivity(record->job_id, faces); },
-                         m_materials, m_jobs.design_checkpoint(record->row_id)};
-      finish_run(*record, *kind, *active, kind->run(context));
+                         m_materials, m_jobs.design_checkpoint(record->row_id), std::move(prepared)};
+      RunOutcome outcome = kind->run(context);
+      flush_progress();  // the last rows before the outcome, so a finished job has all of them
+      finish_run(*record, *kind, *active, std::move(outcome));
     }
   } catch (const std::exception& error) {
     fail_job(*record, std::string("internal error: ") + error.what());
@@ -483,17 +503,36 @@ void JobHandler::fail_job(const store::JobRecord& record, const std::string& err
   m_watches.finish(record.job_id, state_event(record.job_id, v1::JOB_STATE_FAILED, error));
 }
 
-ProgressCallback JobHandler::progress_publisher(const store::JobRecord& record, const v1::JobSpec& spec) {
+ProgressCallback JobHandler::progress_publisher(const store::JobRecord& record, const v1::JobSpec& spec,
+                                                std::function<void()>* flush) {
   const int mesh_every = spec.progress_mesh_every() != 0 ? spec.progress_mesh_every() : m_options.progress_mesh_every;
   // The callback is copied into the solver's options: its counters live behind one shared pointer.
+  // Progress rows are kept at most one per checkpoint_interval_s and written in batches, one transaction
+  // per PROGRESS_BATCH_INTERVAL_S (the first row at once), with the latest shape; the rest at the end.
   struct State {
+    std::mutex mutex;  // the publisher and the final flush may run on different threads
     int shape_events = 0;
-    std::chrono::steady_clock::time_point last_checkpoint{}, last_shape_checkpoint{}, last_rest_checkpoint{};
+    std::chrono::steady_clock::time_point last_checkpoint{}, last_shape_checkpoint{}, last_rest_checkpoint{},
+        last_flush{};
+    std::vector<store::ProgressRecord> pending;
+    std::string pending_shape;
+    std::size_t pending_shape_index = 0;
   };
   auto state = std::make_shared<State>();
   const std::int64_t row_id = record.row_id;
   const std::string job_id = record.job_id;
-  return [this, state, mesh_every, row_id, job_id](const ProgressEvent& progress) {
+  const auto write_pending = [this, row_id](State& s) {
+    // Called with s.mutex held; the store's own lock is taken inside (one short transaction, no fsync).
+    if (s.pending.empty()) return;
+    m_jobs.append_progress_batch(row_id, s.pending, s.pending_shape, s.pending_shape_index);
+    s.pending.clear();
+    s.pending_shape.clear();
+  };
+  *flush = [state, write_pending] {
+    std::lock_guard lock(state->mutex);
+    write_pending(*state);
+  };
+  return [this, state, mesh_every, row_id, job_id, write_pending](const ProgressEvent& progress) {
     v1::JobEvent event;
     event.set_job_id(job_id);
     event.set_state(v1::JOB_STATE_RUNNING);
@@ -508,28 +547,41 @@ ProgressCallback JobHandler::progress_publisher(const store::JobRecord& record, 
     checkpoint.max_error_mm = progress.max_error_mm;
     checkpoint.recorded_ms = event.time_ms();
     fill_progress(checkpoint, event.mutable_progress());
+    std::lock_guard lock(state->mutex);
     if (progress.shape != nullptr && mesh_every > 0 && state->shape_events++ % mesh_every == 0) {
       v1::IntermediateMesh* mesh = event.mutable_mesh();
       mesh->set_vertex_count(static_cast<std::uint32_t>(progress.shape->rows()));
       mesh->set_iteration(progress.iteration);
-      mesh->mutable_positions_mm()->Reserve(static_cast<int>(progress.shape->size()));
+      auto* positions = mesh->mutable_positions_mm();
+      positions->Resize(static_cast<int>(progress.shape->size()), 0.0f);
       for (Eigen::Index i = 0; i < progress.shape->size(); ++i)
-        mesh->add_positions_mm(static_cast<float>(progress.shape->data()[i]));
+        positions->Set(static_cast<int>(i), static_cast<float>(progress.shape->data()[i]));
     }
     const auto now = std::chrono::steady_clock::now();
+    bool recorded = false;  // this event's row is among the pending ones
     if (std::chrono::duration<double>(now - state->last_checkpoint).count() >= m_options.checkpoint_interval_s) {
-      std::string shape;
       if (progress.shape != nullptr &&
           std::chrono::duration<double>(now - state->last_shape_checkpoint).count() >= SHAPE_CHECKPOINT_INTERVAL_S) {
-        shape = store::encode_positions_f32(*progress.shape);
+        state->pending_shape = store::encode_positions_f32(*progress.shape);  // only the latest is kept
+        state->pending_shape_index = state->pending.size();
         state->last_shape_checkpoint = now;
       }
-      m_jobs.append_progress(row_id, checkpoint, shape);
+      state->pending.push_back(checkpoint);
       state->last_checkpoint = now;
+      recorded = true;
+    }
+    if (!state->pending.empty() &&
+        std::chrono::duration<double>(now - state->last_flush).count() >= PROGRESS_BATCH_INTERVAL_S) {
+      write_pending(*state);
+      state->last_flush = now;
     }
     // A design's rest shape is what a restarted run continues from (issue 12): one kept per job.
     if (progress.rest_shape != nullptr && progress.iteration > 0 &&
         std::chrono::duration<double>(now - state->last_rest_checkpoint).count() >= SHAPE_CHECKPOINT_INTERVAL_S) {
+      // The stored progress never lags the resume point: this event's row goes in first.
+      if (!recorded) state->pending.push_back(checkpoint);
+      write_pending(*state);
+      state->last_flush = now;
       m_jobs.save_design_checkpoint(row_id, progress.iteration,
                                     store::encode_mesh_blob(TriMesh{*progress.rest_shape, Faces(0, 3)}));
       state->last_rest_checkpoint = now;

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -76,8 +77,10 @@ class JobHandler {
   /// The one failure path: marks the job failed in the store, logs, and closes its watchers.
   void fail_job(const store::JobRecord& record, const std::string& error);
   /// A progress callback that publishes a running job's events (with the intermediate mesh every K
-  /// events) and checkpoints them in the store at most every checkpoint_interval_s.
-  ProgressCallback progress_publisher(const store::JobRecord& record, const balloon::v1::JobSpec& spec);
+  /// events) and checkpoints them in the store at most every checkpoint_interval_s, in batches; `flush`
+  /// receives the function that writes the rows still pending (called when the run ends).
+  ProgressCallback progress_publisher(const store::JobRecord& record, const balloon::v1::JobSpec& spec,
+                                      std::function<void()>* flush);
   /// Records a job that stopped early: cancelled (already stored), timed out, or re-queued at shutdown.
   void finish_stopped(const store::JobRecord& record, const ActiveJob& active);
   bool acquire_store_lock();
@@ -105,6 +108,11 @@ class JobHandler {
 
   bool m_started = false;
   int m_lock_fd = -1;
+
+  /// Jobs checked at submit in this process, ready to run (CheckedJob::prepared), by row id: the run
+  /// neither parses nor checks them again. At most MAX_PREPARED are kept (the oldest go first).
+  std::mutex m_prepared_mutex;
+  std::map<std::int64_t, std::shared_ptr<const void>> m_prepared;
 
   std::mutex m_request_mutex;  // held from the request_id lookup to the insert
   std::mutex m_id_mutex;

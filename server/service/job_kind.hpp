@@ -3,6 +3,7 @@
 /// run on a worker and returned as a result. Adding a kind touches one implementation file and the
 /// list in job_kinds.cpp; the handler, the pool and the watch hub do not change.
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -29,6 +30,9 @@ struct CheckContext {
 struct CheckedJob {
   balloon::v1::JobSpec stored_spec;  ///< what the store keeps (a stored material's name resolved to its SPEC)
   std::string summary;               ///< one human line
+  /// The decoded, checked job, if the kind hands it to its run (same process: the run then neither parses
+  /// nor checks the spec again). Only the kind that made it reads it.
+  std::shared_ptr<const void> prepared = nullptr;
 };
 
 /// What a running job may use.
@@ -43,6 +47,8 @@ struct RunContext {
   /// The job's last design checkpoint (iteration, rest shape as an encode_mesh_blob), if an earlier run of
   /// it stored one before it was interrupted.
   std::optional<std::pair<int, std::string>> design_checkpoint = std::nullopt;
+  /// What check() prepared for this job at submit in this process (CheckedJob::prepared), or null.
+  std::shared_ptr<const void> prepared = nullptr;
 };
 
 /// How a run ended. The handler records it: one path for each outcome.
@@ -74,7 +80,7 @@ class JobKind {
   /// Fills `reply` from a stored result; meshes in `format` (checked writable by the caller), a design's
   /// mold in STL, and the typed report (fill_report).
   virtual ServiceStatus fill_result(const store::ResultRecord& stored, balloon::v1::MeshFormat format,
-                                    balloon::v1::JobResult* reply) const;
+                                    balloon::v1::JobResult* reply, bool inflated_mesh_only = false) const;
   /// Sets the kind's report in `reply` from the stored one.
   ServiceStatus fill_report(const store::ResultRecord& stored, balloon::v1::JobResult* reply) const;
 };

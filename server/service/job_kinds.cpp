@@ -74,19 +74,21 @@ const JobKind* job_kind_named(const std::string& name) {
 }
 
 ServiceStatus JobKind::fill_result(const store::ResultRecord& stored, v1::MeshFormat format,
-                                   v1::JobResult* reply) const {
-  const Result<TriMesh> rest = store::decode_mesh_blob(stored.rest_mesh);
+                                   v1::JobResult* reply, bool inflated_mesh_only) const {
   const Result<TriMesh> inflated = store::decode_mesh_blob(stored.inflated_mesh);
+  const Result<TriMesh> rest = inflated_mesh_only ? Result<TriMesh>(TriMesh{}) : store::decode_mesh_blob(stored.rest_mesh);
   if (!rest || !inflated) return ServiceStatus::error(StatusCode::Internal, "stored meshes are unreadable");
   const std::string extension = mesh_format_extension(format);
   reply->set_kind(proto_kind());
   reply->set_converged(stored.converged);
-  reply->mutable_rest_mesh()->set_format(format);
-  reply->mutable_rest_mesh()->set_data(write_mesh_to_memory(*rest, extension));
+  if (!inflated_mesh_only) {
+    reply->mutable_rest_mesh()->set_format(format);
+    reply->mutable_rest_mesh()->set_data(write_mesh_to_memory(*rest, extension));
+  }
   reply->mutable_inflated_mesh()->set_format(format);
   reply->mutable_inflated_mesh()->set_data(write_mesh_to_memory(*inflated, extension));
   if (ServiceStatus report = fill_report(stored, reply); !report.ok()) return report;
-  if (proto_kind() == v1::JOB_KIND_DESIGN) {
+  if (proto_kind() == v1::JOB_KIND_DESIGN && !inflated_mesh_only) {
     Result<std::string> mold = mold_stl(stored, *rest, reply->design_report());
     if (!mold) return ServiceStatus::error(StatusCode::Internal, mold.error());
     if (!mold->empty()) {

@@ -21,6 +21,9 @@ struct ServiceOptions {
   int max_watches_per_tenant = 64;      ///< open watch streams per tenant; more get RESOURCE_EXHAUSTED; 0 no limit
   int max_stored_mb_per_tenant = 2048;  ///< MiB of specs and results a tenant may store; 0 no limit
   double retention_days = 90.0;         ///< finished jobs older than this are deleted (days); 0 keeps them forever
+  /// true: a submitted job, a result or a state change is on disk (fdatasync) before the call returns.
+  /// false (the CLI's embedded store): commits survive a crash of the process, not of the machine.
+  bool durable_store = true;
   bool run_jobs = true;                 ///< false: accept and store jobs but start no workers (a short-lived CLI)
   std::string shard_name;               ///< --shard-name: prefixes every new job id ("s2-j-..."); empty: none
   /// Receives one log line per job event; empty for silence (the embedded CLI server).

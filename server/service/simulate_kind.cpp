@@ -65,15 +65,23 @@ class SimulateKind final : public JobKind {
     if (names_stored_material(spec.simulate().material()))
       checked->stored_spec.mutable_simulate()->mutable_material()->set_spec(material_spec(input->material));
     checked->summary = simulate_summary(*input);
+    checked->prepared = std::make_shared<const jobs::SimulateInput>(std::move(*input));
     return ServiceStatus::success();
   }
 
   RunOutcome run(RunContext& context) const override {
-    // The limit on vertices was applied at submit time; a job accepted then runs now even if the limit shrank.
-    std::optional<jobs::SimulateInput> loaded;
-    const ServiceStatus status = load_simulate(context.spec.simulate(), context.record.owner, 0, context.materials, &loaded);
-    if (!status.ok()) return RunOutcome::failed(status.message);
-    const jobs::SimulateInput& input = *loaded;
+    // Checked at submit in this process: as prepared then. Otherwise (a restart, a recovered job) from the
+    // stored spec; the limit on vertices was applied at submit, so a job accepted then runs now even if the
+    // limit shrank.
+    auto prepared = std::static_pointer_cast<const jobs::SimulateInput>(context.prepared);
+    if (!prepared) {
+      std::optional<jobs::SimulateInput> loaded;
+      const ServiceStatus status =
+          load_simulate(context.spec.simulate(), context.record.owner, 0, context.materials, &loaded);
+      if (!status.ok()) return RunOutcome::failed(status.message);
+      prepared = std::make_shared<const jobs::SimulateInput>(std::move(*loaded));
+    }
+    const jobs::SimulateInput& input = *prepared;
     context.set_connectivity(input.rest.faces);
     jobs::RunControls controls;
     controls.cancel = &context.cancel;

@@ -1,6 +1,14 @@
 #include "service/worker_pool.hpp"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 namespace balloon::service {
+namespace {
+
+constexpr int WORKER_NICE = 10;  // the worker threads' niceness (the process's other threads keep theirs)
+
+}  // namespace
 
 void ActiveJob::stop(StopReason reason) {
   int expected = static_cast<int>(StopReason::None);
@@ -20,6 +28,9 @@ void WorkerPool::start(int workers) {
 }
 
 void WorkerPool::worker_loop() {
+  // Solving is batch work: below the threads that answer calls and stream events, so a submit or a
+  // progress event is not queued behind a busy core (Linux: nice is per thread).
+  ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), WORKER_NICE);
   while (const std::optional<JobQueue::Popped> popped = m_queue.pop()) {
     try {
       m_run(popped->row_id);

@@ -11,7 +11,7 @@ namespace {
 
 }  // namespace
 
-Database::Database(const std::string& path, int busy_timeout_ms) : m_path(path) {
+Database::Database(const std::string& path, int busy_timeout_ms, Synchronous synchronous) : m_path(path) {
   const int flags = SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX;
   if (sqlite3_open_v2(path.c_str(), &m_db, flags, nullptr) != SQLITE_OK) {
     const std::string message = m_db != nullptr ? sqlite3_errmsg(m_db) : "out of memory";
@@ -21,10 +21,13 @@ Database::Database(const std::string& path, int busy_timeout_ms) : m_path(path) 
   }
   sqlite3_extended_result_codes(m_db, 1);
   sqlite3_busy_timeout(m_db, busy_timeout_ms);
-  // WAL lets readers proceed during a write; synchronous=FULL makes every commit durable across power
-  // loss, which is what "a job is in the database before SubmitJob returns" needs.
+  // WAL lets readers proceed during a write. synchronous=FULL makes every commit durable across power
+  // loss; NORMAL leaves the flush to the owner (Store::sync), so it need not happen under a lock.
   if (path != ":memory:") execute("PRAGMA journal_mode = WAL");
-  execute("PRAGMA synchronous = FULL; PRAGMA foreign_keys = ON");
+  execute(synchronous == Synchronous::Full ? "PRAGMA synchronous = FULL; PRAGMA foreign_keys = ON"
+                                           : "PRAGMA synchronous = NORMAL; PRAGMA foreign_keys = ON");
+  // Statement journals and sorts in memory: a result's multi-MB blobs must not be copied to /var/tmp.
+  execute("PRAGMA temp_store = MEMORY");
 }
 
 Database::~Database() {
@@ -48,6 +51,12 @@ Statement Database::prepare(std::string_view sql) {
   if (sqlite3_prepare_v2(m_db, sql.data(), static_cast<int>(sql.size()), &statement, nullptr) != SQLITE_OK)
     throw_error(m_db, "preparing '" + std::string(sql.substr(0, 60)) + "'");
   return Statement(*this, statement);
+}
+
+void Database::interrupt() { sqlite3_interrupt(m_db); }
+
+void Database::keep_wal_on_close() {
+  sqlite3_db_config(m_db, SQLITE_DBCONFIG_NO_CKPT_ON_CLOSE, 1, nullptr);
 }
 
 std::int64_t Database::last_insert_id() const { return sqlite3_last_insert_rowid(m_db); }

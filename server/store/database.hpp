@@ -21,13 +21,17 @@ class DatabaseError : public std::runtime_error {
 
 class Statement;
 
+/// When a commit is flushed to disk. Full: at every commit (durable on return). Normal: at checkpoints
+/// only (a commit survives a process crash; the owner flushes the WAL itself when it needs durability).
+enum class Synchronous { Full, Normal };
+
 /// One open connection, in WAL mode with a busy timeout and foreign keys on. Not thread-safe: the owner
 /// serializes access (JobStore holds a mutex).
 class Database {
  public:
   /// Opens (creating if needed) the database at `path`; ":memory:" for a private in-memory one.
   /// `busy_timeout_ms` is how long a write waits for another connection's lock (ms).
-  explicit Database(const std::string& path, int busy_timeout_ms = 5000);
+  explicit Database(const std::string& path, int busy_timeout_ms = 5000, Synchronous synchronous = Synchronous::Full);
   ~Database();
   Database(const Database&) = delete;
   Database& operator=(const Database&) = delete;
@@ -41,6 +45,10 @@ class Database {
   std::int64_t last_insert_id() const;
   /// Rows changed by the last INSERT, UPDATE or DELETE.
   int changes() const;
+  /// Leaves the WAL as it is when this connection, the last one, closes (no checkpoint, no fsync at close).
+  void keep_wal_on_close();
+  /// Makes a statement running on this connection (from another thread) stop soon with an error.
+  void interrupt();
   /// The path it was opened with.
   const std::string& path() const { return m_path; }
 

@@ -132,19 +132,20 @@ JobState job_state_from_string(const std::string& text) {
 }
 
 void JobStore::insert(JobRecord& job) {
-  std::lock_guard lock(m_store.mutex());
-  Statement statement = m_store.database().prepare(INSERT_JOB);
-  statement.bind(1, job.job_id)
-      .bind(2, job.owner)
-      .bind(3, job.kind)
-      .bind(4, to_string(job.state))
-      .bind(5, job.priority)
-      .bind_blob(6, job.spec)
-      .bind(7, job.summary)
-      .bind(8, job.created_ms)
-      .bind(9, job.request_id);
-  statement.run();
-  job.row_id = m_store.database().last_insert_id();
+  return m_store.write_durably([&] {
+    Statement statement = m_store.database().prepare(INSERT_JOB);
+    statement.bind(1, job.job_id)
+        .bind(2, job.owner)
+        .bind(3, job.kind)
+        .bind(4, to_string(job.state))
+        .bind(5, job.priority)
+        .bind_blob(6, job.spec)
+        .bind(7, job.summary)
+        .bind(8, job.created_ms)
+        .bind(9, job.request_id);
+    statement.run();
+    job.row_id = m_store.database().last_insert_id();
+  });
 }
 
 std::optional<JobRecord> JobStore::find(const std::string& job_id) {
@@ -199,64 +200,77 @@ bool JobStore::mark_running(std::int64_t row_id) {
 }
 
 bool JobStore::mark_cancelled(std::int64_t row_id, const std::string& reason) {
-  std::lock_guard lock(m_store.mutex());
-  Statement statement = m_store.database().prepare(MARK_CANCELLED);
-  statement.bind(1, reason).bind(2, now_ms()).bind(3, row_id).run();
-  return m_store.database().changes() == 1;
+  return m_store.write_durably([&] {
+    Statement statement = m_store.database().prepare(MARK_CANCELLED);
+    statement.bind(1, reason).bind(2, now_ms()).bind(3, row_id).run();
+    return m_store.database().changes() == 1;
+  });
 }
 
 void JobStore::mark_requeued(std::int64_t row_id) {
-  std::lock_guard lock(m_store.mutex());
-  m_store.database().prepare(MARK_REQUEUED).bind(1, row_id).run();
+  return m_store.write_durably([&] {
+    m_store.database().prepare(MARK_REQUEUED).bind(1, row_id).run();
+  });
 }
 
 bool JobStore::mark_completed(std::int64_t row_id, const ResultRecord& result) {
-  std::lock_guard lock(m_store.mutex());
-  Transaction transaction(m_store.database());
-  const std::int64_t now = now_ms();
-  m_store.database().prepare(MARK_COMPLETED).bind(1, result.converged ? 1 : 0).bind(2, now).bind(3, row_id).run();
-  if (m_store.database().changes() != 1) return false;  // the transaction rolls back
-  Statement insert = m_store.database().prepare(INSERT_RESULT);
-  insert.bind(1, row_id)
-      .bind(2, result.converged ? 1 : 0)
-      .bind_blob(3, result.rest_mesh)
-      .bind_blob(4, result.inflated_mesh)
-      .bind(5, result.report_json)
-      .bind(6, now)
-      .bind_blob(7, result.report);
-  if (result.mold_mesh.empty())
-    insert.bind_null(8);
-  else
-    insert.bind_blob(8, result.mold_mesh);
-  insert.run();
-  transaction.commit();
-  return true;
+  return m_store.write_durably([&] {
+    Transaction transaction(m_store.database());
+    const std::int64_t now = now_ms();
+    m_store.database().prepare(MARK_COMPLETED).bind(1, result.converged ? 1 : 0).bind(2, now).bind(3, row_id).run();
+    if (m_store.database().changes() != 1) return false;  // the transaction rolls back
+    Statement insert = m_store.database().prepare(INSERT_RESULT);
+    insert.bind(1, row_id)
+        .bind(2, result.converged ? 1 : 0)
+        .bind_blob(3, result.rest_mesh)
+        .bind_blob(4, result.inflated_mesh)
+        .bind(5, result.report_json)
+        .bind(6, now)
+        .bind_blob(7, result.report);
+    if (result.mold_mesh.empty())
+      insert.bind_null(8);
+    else
+      insert.bind_blob(8, result.mold_mesh);
+    insert.run();
+    transaction.commit();
+    return true;
+  });
 }
 
 void JobStore::mark_failed(std::int64_t row_id, const std::string& error) {
-  std::lock_guard lock(m_store.mutex());
-  m_store.database().prepare(MARK_FAILED).bind(1, error).bind(2, now_ms()).bind(3, row_id).run();
+  return m_store.write_durably([&] {
+    m_store.database().prepare(MARK_FAILED).bind(1, error).bind(2, now_ms()).bind(3, row_id).run();
+  });
 }
 
 void JobStore::append_progress(std::int64_t row_id, const ProgressRecord& progress, const std::string& shape) {
+  append_progress_batch(row_id, {progress}, shape, 0);
+}
+
+void JobStore::append_progress_batch(std::int64_t row_id, const std::vector<ProgressRecord>& progress,
+                                     const std::string& shape, std::size_t shape_index) {
+  if (progress.empty()) return;
   std::lock_guard lock(m_store.mutex());
   Transaction transaction(m_store.database());
   if (!shape.empty()) m_store.database().prepare(CLEAR_OLD_SHAPES).bind(1, row_id).run();
   Statement statement = m_store.database().prepare(INSERT_PROGRESS);
-  statement.bind(1, row_id)
-      .bind(2, progress.phase)
-      .bind(3, progress.iteration)
-      .bind(4, progress.elapsed_s)
-      .bind(5, progress.residual_norm)
-      .bind(6, progress.pressure_kpa)
-      .bind(7, progress.avg_error_mm)
-      .bind(8, progress.max_error_mm)
-      .bind(9, progress.recorded_ms);
-  if (shape.empty())
-    statement.bind_null(10);
-  else
-    statement.bind_blob(10, shape);
-  statement.run();
+  for (std::size_t i = 0; i < progress.size(); ++i) {
+    statement.bind(1, row_id)
+        .bind(2, progress[i].phase)
+        .bind(3, progress[i].iteration)
+        .bind(4, progress[i].elapsed_s)
+        .bind(5, progress[i].residual_norm)
+        .bind(6, progress[i].pressure_kpa)
+        .bind(7, progress[i].avg_error_mm)
+        .bind(8, progress[i].max_error_mm)
+        .bind(9, progress[i].recorded_ms);
+    if (shape.empty() || i != shape_index)
+      statement.bind_null(10);
+    else
+      statement.bind_blob(10, shape);
+    statement.run();
+    statement.reset();
+  }
   transaction.commit();
 }
 
@@ -295,9 +309,10 @@ int JobStore::progress_count(std::int64_t row_id) {
 }
 
 bool JobStore::delete_finished(std::int64_t row_id) {
-  std::lock_guard lock(m_store.mutex());
-  m_store.database().prepare(DELETE_FINISHED_JOB).bind(1, row_id).run();
-  return m_store.database().changes() == 1;
+  return m_store.write_durably([&] {
+    m_store.database().prepare(DELETE_FINISHED_JOB).bind(1, row_id).run();
+    return m_store.database().changes() == 1;
+  });
 }
 
 int JobStore::delete_finished_before(std::int64_t cutoff_ms) {
@@ -330,31 +345,32 @@ std::optional<ResultRecord> JobStore::result(std::int64_t row_id) {
 }
 
 JobStore::Recovery JobStore::recover_unfinished(int max_attempts) {
-  std::lock_guard lock(m_store.mutex());
-  Transaction transaction(m_store.database());
-  Recovery recovery;
-  if (max_attempts > 0) {
+  return m_store.write_durably([&] {
+    Transaction transaction(m_store.database());
+    Recovery recovery;
+    if (max_attempts > 0) {
+      {
+        Statement statement = m_store.database().prepare(SELECT_CRASHED_JOBS);
+        statement.bind(1, max_attempts);
+        while (statement.step()) recovery.crashed.push_back(read_job(statement));
+      }
+      const std::int64_t now = now_ms();
+      for (JobRecord& job : recovery.crashed) {
+        job.state = JobState::Failed;
+        job.error = "crashed the server " + std::to_string(job.attempts) + " times (--max-attempts " +
+                    std::to_string(max_attempts) + "); it is not run again";
+        job.finished_ms = now;
+        m_store.database().prepare(MARK_FAILED).bind(1, job.error).bind(2, now).bind(3, job.row_id).run();
+      }
+    }
+    m_store.database().execute(REQUEUE_ALL_RUNNING);
     {
-      Statement statement = m_store.database().prepare(SELECT_CRASHED_JOBS);
-      statement.bind(1, max_attempts);
-      while (statement.step()) recovery.crashed.push_back(read_job(statement));
+      Statement statement = m_store.database().prepare(SELECT_QUEUED_JOBS);
+      while (statement.step()) recovery.queued.push_back(read_job(statement));
     }
-    const std::int64_t now = now_ms();
-    for (JobRecord& job : recovery.crashed) {
-      job.state = JobState::Failed;
-      job.error = "crashed the server " + std::to_string(job.attempts) + " times (--max-attempts " +
-                  std::to_string(max_attempts) + "); it is not run again";
-      job.finished_ms = now;
-      m_store.database().prepare(MARK_FAILED).bind(1, job.error).bind(2, now).bind(3, job.row_id).run();
-    }
-  }
-  m_store.database().execute(REQUEUE_ALL_RUNNING);
-  {
-    Statement statement = m_store.database().prepare(SELECT_QUEUED_JOBS);
-    while (statement.step()) recovery.queued.push_back(read_job(statement));
-  }
-  transaction.commit();
-  return recovery;
+    transaction.commit();
+    return recovery;
+  });
 }
 
 }  // namespace balloon::store

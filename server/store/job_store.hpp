@@ -102,6 +102,10 @@ class JobStore {
   /// Appends a progress checkpoint; `shape` (float32 positions, may be empty) replaces the job's earlier
   /// stored shape, so a job keeps at most one.
   void append_progress(std::int64_t row_id, const ProgressRecord& progress, const std::string& shape);
+  /// Appends several checkpoints in one transaction (not flushed to disk: a power loss may lose them);
+  /// `shape` (may be empty) goes with progress[shape_index] and replaces the job's earlier stored shape.
+  void append_progress_batch(std::int64_t row_id, const std::vector<ProgressRecord>& progress,
+                             const std::string& shape, std::size_t shape_index);
   /// The latest checkpointed shape (float32 positions), if any.
   std::optional<std::string> latest_shape(std::int64_t row_id);
   /// Number of progress checkpoints of a job.

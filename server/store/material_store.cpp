@@ -28,27 +28,28 @@ MaterialRecord read_material(const Statement& row) {
 
 MaterialRecord MaterialStore::put(const std::string& owner, const std::string& name, const std::string& spec,
                                   const std::string& description) {
-  std::lock_guard lock(m_store.mutex());
-  Transaction transaction(m_store.database());
-  const std::int64_t now = now_ms();
-  m_store.database()
-      .prepare(UPSERT_MATERIAL)
-      .bind(1, owner)
-      .bind(2, name)
-      .bind(3, spec)
-      .bind(4, description)
-      .bind(5, now)
-      .bind(6, now)
-      .run();
-  MaterialRecord record;
-  {
-    Statement statement = m_store.database().prepare(SELECT_MATERIAL);
-    statement.bind(1, owner).bind(2, name);
-    if (!statement.step()) throw DatabaseError("material vanished after insert");
-    record = read_material(statement);
-  }
-  transaction.commit();
-  return record;
+  return m_store.write_durably([&] {
+    Transaction transaction(m_store.database());
+    const std::int64_t now = now_ms();
+    m_store.database()
+        .prepare(UPSERT_MATERIAL)
+        .bind(1, owner)
+        .bind(2, name)
+        .bind(3, spec)
+        .bind(4, description)
+        .bind(5, now)
+        .bind(6, now)
+        .run();
+    MaterialRecord record;
+    {
+      Statement statement = m_store.database().prepare(SELECT_MATERIAL);
+      statement.bind(1, owner).bind(2, name);
+      if (!statement.step()) throw DatabaseError("material vanished after insert");
+      record = read_material(statement);
+    }
+    transaction.commit();
+    return record;
+  });
 }
 
 std::optional<MaterialRecord> MaterialStore::get(const std::string& owner, const std::string& name) {
@@ -69,9 +70,10 @@ std::vector<MaterialRecord> MaterialStore::list(const std::string& owner) {
 }
 
 bool MaterialStore::remove(const std::string& owner, const std::string& name) {
-  std::lock_guard lock(m_store.mutex());
-  m_store.database().prepare(DELETE_MATERIAL).bind(1, owner).bind(2, name).run();
-  return m_store.database().changes() == 1;
+  return m_store.write_durably([&] {
+    m_store.database().prepare(DELETE_MATERIAL).bind(1, owner).bind(2, name).run();
+    return m_store.database().changes() == 1;
+  });
 }
 
 }  // namespace balloon::store

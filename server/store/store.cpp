@@ -1,16 +1,119 @@
 #include "store/store.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <chrono>
 
 #include "store/schema.hpp"
 
 namespace balloon::store {
+namespace {
+
+/// The WAL is copied into the database once it holds this much (bytes): about 1,000 pages, SQLite's own
+/// default, but done by the checkpointer instead of by whichever commit crosses the line.
+constexpr off_t CHECKPOINT_WAL_BYTES = 4 << 20;
+/// The checkpointer also looks at the WAL this often when nothing wakes it.
+constexpr std::chrono::seconds CHECKPOINT_PERIOD{5};
+
+bool in_memory(const std::string& path) { return path.empty() || path == ":memory:"; }
+
+}  // namespace
 
 std::int64_t now_ms() {
   return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch())
       .count();
 }
 
-Store::Store(const std::string& path) : m_database(path) { migrate(m_database); }
+Store::Store(const std::string& path, StoreOptions options)
+    : m_options(options), m_database(path, 5000, Synchronous::Normal) {
+  migrate(m_database);
+  if (in_memory(path)) return;
+  // Commits never checkpoint inline (that would fsync the database under the mutex): the checkpointer does.
+  m_database.execute("PRAGMA wal_autocheckpoint = 0; PRAGMA journal_size_limit = 67108864");
+  m_wal_fd = ::open((path + "-wal").c_str(), O_RDONLY | O_CLOEXEC);
+  if (m_wal_fd < 0) {
+    // No WAL file to sync (an unusual file system): fall back to a flush at every commit.
+    m_database.execute("PRAGMA synchronous = FULL; PRAGMA wal_autocheckpoint = 1000");
+    return;
+  }
+  m_checkpoint_database = std::make_unique<Database>(path, 5000, Synchronous::Normal);
+  if (!m_options.durable) {
+    // A short-lived command: closing must not checkpoint (fsyncs at every exit, and a new WAL whose
+    // header and folder are synced at the next start). The WAL is read back at the next open instead;
+    // once it has grown, the checkpointer copies it in the background of a later command.
+    m_database.keep_wal_on_close();
+    m_checkpoint_database->keep_wal_on_close();
+    struct stat info {};
+    m_checkpoint_due = ::fstat(m_wal_fd, &info) == 0 && info.st_size >= CHECKPOINT_WAL_BYTES;
+  }
+  m_checkpointer = std::thread([this] { checkpoint_loop(); });
+}
+
+Store::~Store() {
+  {
+    std::lock_guard lock(m_checkpoint_mutex);
+    m_stopping = true;
+  }
+  m_checkpoint_wake.notify_all();
+  // A checkpoint under way stops where it is (what it copied stays copied): closing does not wait for it.
+  if (m_checkpoint_database) m_checkpoint_database->interrupt();
+  if (m_checkpointer.joinable()) m_checkpointer.join();
+  m_checkpoint_database.reset();
+  if (m_wal_fd >= 0) ::close(m_wal_fd);
+}
+
+void Store::sync() {
+  // Not durable (a command's store): no flush, and no checkpoint during the command either (its fsyncs
+  // would compete with the work); what the WAL holds is copied when a later command opens the store.
+  if (m_wal_fd < 0 || !m_options.durable) return;
+  {
+    std::unique_lock lock(m_sync_mutex);
+    const std::uint64_t mine = ++m_sync_requested;
+    while (m_sync_covered < mine) {
+      if (m_syncing) {
+        m_sync_done.wait(lock);  // the flush under way may have started before this commit: wait for it
+        continue;
+      }
+      m_syncing = true;  // lead the next flush: it covers every caller so far
+      const std::uint64_t covers = m_sync_requested;
+      lock.unlock();
+      ::fdatasync(m_wal_fd);
+      lock.lock();
+      m_sync_covered = covers;
+      m_syncing = false;
+      m_sync_done.notify_all();
+    }
+  }
+  struct stat info {};
+  if (::fstat(m_wal_fd, &info) == 0 && info.st_size >= CHECKPOINT_WAL_BYTES) {
+    {
+      std::lock_guard lock(m_checkpoint_mutex);
+      m_checkpoint_due = true;
+    }
+    m_checkpoint_wake.notify_one();
+  }
+}
+
+void Store::checkpoint_loop() {
+  std::unique_lock lock(m_checkpoint_mutex);
+  while (!m_stopping) {
+    m_checkpoint_wake.wait_for(lock, CHECKPOINT_PERIOD, [this] { return m_stopping || m_checkpoint_due; });
+    if (m_stopping) break;
+    if (!m_checkpoint_due && !m_options.durable) continue;  // a command's store: only what open found
+    m_checkpoint_due = false;
+    struct stat info {};
+    if (::fstat(m_wal_fd, &info) != 0 || info.st_size == 0) continue;
+    lock.unlock();
+    try {
+      // PASSIVE: copies what no reader still needs, without blocking the writer or the readers.
+      m_checkpoint_database->execute("PRAGMA wal_checkpoint(PASSIVE)");
+    } catch (const DatabaseError&) {
+      // Busy or failing: the next round tries again; the WAL only grows meanwhile.
+    }
+    lock.lock();
+  }
+}
 
 }  // namespace balloon::store

@@ -207,7 +207,7 @@ def main():
         f.writelines(f"{tenant} {TOKENS[tenant]}\n" for tenant in TENANTS)
     cli = Cli(options.cli)
     small, large = (os.path.join(scratch, f"{size}.obj") for size in ("small", "large"))
-    for path, subdivisions in ((small, 2), (large, 4)):
+    for path, subdivisions in ((small, 2), (large, 5)):
         made = subprocess.run([options.cli, "mesh", "sphere", "--radius", "10", "--subdivisions", str(subdivisions),
                                "--out", path], capture_output=True, text=True)
         check(made.returncode == 0, made.stderr)
@@ -414,7 +414,7 @@ def run_scenario(cli, shards, balancer, small, large, scratch):
             obj = reply.read().decode()
             disposition = reply.headers.get("Content-Disposition", "")
         vertices = sum(1 for line in obj.splitlines() if line.startswith("v "))
-        check(vertices == 2562 and "attachment" in disposition, f"download: {vertices} vertices, {disposition!r}")
+        check(vertices == 10242 and "attachment" in disposition, f"download: {vertices} vertices, {disposition!r}")
         print(f"phase 4: HTTP through the balancer: {len(events)} SSE events, inflated.obj {len(obj)} bytes",
               flush=True)
     for tenant in TENANTS:  # everything finished before the stores are read

@@ -1,6 +1,12 @@
 // Unit tests of the job store's lifecycle queries: recovery by the attempts rule, request ids, deletion
-// and the bytes a tenant stores. A private ":memory:" store each.
+// and the bytes a tenant stores, progress batches, and a command's store reopened from its WAL. A private
+// ":memory:" store each, except the reopened one (a temporary file).
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <string>
+#include <vector>
 
 #include "store/job_store.hpp"
 
@@ -116,6 +122,61 @@ TEST(JobStore, ResultsKeepTheirReportAndMold) {
   ASSERT_TRUE(plain);
   EXPECT_EQ(plain->mold_mesh, "");
   EXPECT_EQ(plain->report, with_mold.report);
+}
+
+TEST(JobStore, AProgressBatchIsOneWriteAndKeepsItsShapeWithItsRow) {
+  Store store(":memory:");
+  JobStore jobs(store);
+  const JobRecord job = queued_job(jobs, "j-batch", "alice");
+  ASSERT_TRUE(jobs.mark_running(job.row_id));
+  std::vector<ProgressRecord> rows(3);
+  for (int i = 0; i < 3; ++i) {
+    rows[static_cast<std::size_t>(i)].phase = "inflate";
+    rows[static_cast<std::size_t>(i)].iteration = i + 1;
+    rows[static_cast<std::size_t>(i)].pressure_kpa = 1.5 * (i + 1);
+  }
+  jobs.append_progress(job.row_id, rows[0], "old shape");
+  jobs.append_progress_batch(job.row_id, rows, "new shape", 1);
+  EXPECT_EQ(jobs.progress_count(job.row_id), 4);
+  EXPECT_EQ(jobs.latest_shape(job.row_id).value_or(""), "new shape") << "a job keeps one stored shape";
+  const auto found = jobs.find("j-batch");
+  ASSERT_TRUE(found && found->last_progress);
+  EXPECT_EQ(found->last_progress->iteration, 3);
+  EXPECT_NEAR(found->last_progress->pressure_kpa, 4.5, 1e-12);
+  jobs.append_progress_batch(job.row_id, {}, "ignored", 0);
+  EXPECT_EQ(jobs.progress_count(job.row_id), 4) << "an empty batch writes nothing";
+}
+
+TEST(JobStore, ACommandsStoreKeepsItsWalAtCloseAndTheNextOpenReadsIt) {
+  // The embedded CLI store neither flushes nor checkpoints at close: what it committed must still be
+  // there for the next command (the WAL is read back at open).
+  const std::string path = ::testing::TempDir() + "balloon-store-wal-" + std::to_string(::getpid()) + ".db";
+  for (const char* suffix : {"", "-wal", "-shm"}) std::remove((path + suffix).c_str());
+  {
+    Store store(path, StoreOptions{false});
+    JobStore jobs(store);
+    JobRecord job = queued_job(jobs, "j-kept", "alice");
+    ResultRecord result;
+    result.converged = true;
+    result.rest_mesh = std::string(300000, 'r');
+    result.inflated_mesh = std::string(300000, 'i');
+    ASSERT_TRUE(jobs.mark_running(job.row_id));
+    ASSERT_TRUE(jobs.mark_completed(job.row_id, result));
+  }
+  std::FILE* wal = std::fopen((path + "-wal").c_str(), "rb");
+  EXPECT_NE(wal, nullptr) << "the WAL was checkpointed and removed at close";
+  if (wal) std::fclose(wal);
+  {
+    Store store(path, StoreOptions{false});
+    JobStore jobs(store);
+    const auto found = jobs.find("j-kept");
+    ASSERT_TRUE(found);
+    EXPECT_EQ(found->state, JobState::Completed);
+    const auto result = jobs.result(found->row_id);
+    ASSERT_TRUE(result);
+    EXPECT_EQ(result->inflated_mesh.size(), 300000u);
+  }
+  for (const char* suffix : {"", "-wal", "-shm"}) std::remove((path + suffix).c_str());
 }
 
 }  // namespace

@@ -253,3 +253,52 @@ TEST(ServiceJobs, DesignJobStreamsIntermediateMeshesAndReturnsAReport) {
 
 }  // namespace
 }  // namespace balloon::testing
+
+namespace balloon::testing {
+namespace {
+
+int obj_vertex_lines(const std::string& obj) {
+  int count = 0;
+  std::istringstream lines(obj);
+  for (std::string line; std::getline(lines, line);) count += line.rfind("v ", 0) == 0 ? 1 : 0;
+  return count;
+}
+
+// GetResultRequest.inflated_mesh_only (issue 14): the CLI's `simulate --out` needs the inflated mesh only,
+// so the rest mesh is neither converted nor sent; without it both come back.
+TEST(ServiceJobs, InflatedMeshOnlyLeavesOutTheRestMesh) {
+  ScratchDir scratch;
+  ServerProcess server(scratch.file("jobs.db"), {"--workers", "1"});
+  auto stub = server.stub();
+  v1::SubmitJobRequest request;
+  v1::SimulateJob* job = request.mutable_spec()->mutable_simulate();
+  job->mutable_rest_mesh()->set_data(write_mesh_to_memory(make_icosphere(10.0, 2), "obj"));
+  job->mutable_rest_mesh()->set_format(v1::MESH_FORMAT_OBJ);
+  job->mutable_material()->set_spec("neo-hookean:mu=0.3");
+  job->set_volume_ratio(2.0);
+  std::string job_id;
+  const grpc::Status submitted = submit_job(*stub, request, &job_id);
+  ASSERT_TRUE(submitted.ok()) << submitted.error_message();
+  grpc::Status status;
+  const std::vector<v1::JobEvent> events = watch_all(*stub, job_id, &status);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_FALSE(events.empty());
+  ASSERT_EQ(events.back().state(), v1::JOB_STATE_COMPLETED) << events.back().message();
+
+  for (const bool inflated_only : {true, false}) {
+    grpc::ClientContext context;
+    v1::GetResultRequest result_request;
+    result_request.set_job_id(job_id);
+    result_request.set_inflated_mesh_only(inflated_only);
+    v1::JobResult result;
+    const grpc::Status got = stub->GetResult(&context, result_request, &result);
+    ASSERT_TRUE(got.ok()) << got.error_message();
+    EXPECT_EQ(obj_vertex_lines(result.inflated_mesh().data()), 162) << "inflated_mesh_only " << inflated_only;
+    EXPECT_EQ(obj_vertex_lines(result.rest_mesh().data()), inflated_only ? 0 : 162);
+    ASSERT_TRUE(result.has_simulate_report());
+    EXPECT_NEAR(result.simulate_report().volume_ratio(), 2.0, 1e-6);
+  }
+}
+
+}  // namespace
+}  // namespace balloon::testing
