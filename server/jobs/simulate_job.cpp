@@ -23,9 +23,10 @@ std::vector<FieldProblem> simulate_parameter_problems(const SimulateParameters& 
     problems.push_back({"thickness_mm", "thickness must be a positive number of mm, got " + format_number(parameters.thickness_mm)});
   const int controls = (parameters.pressure_kpa ? 1 : 0) + (parameters.volume_ratio ? 1 : 0) + (parameters.curve ? 1 : 0);
   if (controls > 1)
-    problems.push_back({"pressure_kpa", "give one of a pressure, a volume ratio or a curve range, not several"});
+    problems.push_back({"pressure_kpa", parameters.curve ? "give a curve range or a single pressure or volume ratio, not both"
+                                                         : "give either a pressure or a volume ratio, not both"});
   else if (controls == 0)
-    problems.push_back({"pressure_kpa", "give a pressure (kPa), a volume ratio or a curve range"});
+    problems.push_back({"pressure_kpa", "give a pressure (kPa) or a volume ratio (or a curve range)"});
   else if (parameters.pressure_kpa && (!std::isfinite(*parameters.pressure_kpa) || *parameters.pressure_kpa <= 0.0))
     problems.push_back({"pressure_kpa", "pressure must be a positive number of kPa, got " + format_number(*parameters.pressure_kpa)});
   else if (parameters.volume_ratio && (!std::isfinite(*parameters.volume_ratio) || *parameters.volume_ratio <= 0.0))
