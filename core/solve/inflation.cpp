@@ -121,6 +121,11 @@ class InflationRun {
     return result;
   }
 
+  /// Continuation predictor for a path of many targets (InflationPath): the shape secant below, and the
+  /// least-squares pressure of the predicted shape rather than the last pressure. Together they save
+  /// about one Newton step per curve point.
+  void use_path_predictor() { m_path_predictor = true; }
+
   /// Unstable directions of the current state under pressure control: the negative eigenvalues of the
   /// stiffness K = Hess(W - p V) over the free coordinates (0 when K is positive definite). One
   /// supernodal LL^T; the simplicial LDL^T for the inertia only when that fails. -1 when K is singular.
@@ -366,12 +371,7 @@ class InflationRun {
   double m_rest_volume = 0.0;
   std::string m_problem;  ///< why the path cannot start; empty when it can
   std::unique_ptr<Inertia> m_inertia;  ///< made on first use
-
- public:
-  /// Continuation predictor for a path of many targets (InflationPath sets it): the shape secant above,
-  /// and the least-squares pressure of the predicted shape rather than the last pressure. Together they
-  /// save about one Newton step per curve point.
-  bool m_path_predictor = false;
+  bool m_path_predictor = false;  ///< see use_path_predictor()
   PathPoint m_previous;  ///< the equilibrium before the current state (path predictor)
 };
 
@@ -417,7 +417,7 @@ struct InflationPath::Impl {
       : rest(rest_mesh), options(path_options), problem(options_problem(rest, options)) {
     if (problem.empty()) {
       run = std::make_unique<InflationRun>(rest, options);
-      run->m_path_predictor = true;
+      run->use_path_predictor();
     }
   }
   TriMesh rest;  // copies: the run keeps references to both
