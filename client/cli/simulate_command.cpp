@@ -65,8 +65,9 @@ constexpr const char* HELP =
     "control: of the volume-constrained system; 0 = stable). The first point without an equilibrium ends\n"
     "the path: it and every later point are rows with converged=false (report.json's message says why).\n"
     "curve.svg: pressure against volume ratio (log scale), pressure maxima and minima marked.\n\n"
-    "Exit codes: 0 converged (a curve: every point), 2 bad input (one line on stderr names it), 3 not\n"
-    "converged (the result is still printed, no --out mesh; a curve still writes curve.csv and curve.svg),\n"
+    "Exit codes: 0 converged (a curve: every point), 2 bad input (one line on stderr names it),\n"
+    "3 not converged (the result is still printed, no --out mesh; a curve still writes curve.csv and\n"
+    "curve.svg),\n"
     "5 server unreachable or busy, 6 not allowed, 8 the job failed, 130 interrupted (the job keeps\n"
     "running), 1 internal error.\n\n";
 
