@@ -39,5 +39,7 @@ int run_fit_material_command(const std::vector<std::string>& args, const GlobalO
 std::string design_summary(const balloon::v1::DesignReport& report, const std::string& out_dir);
 /// The human summary of a simulate report.
 std::string simulate_summary(const balloon::v1::SimulateReport& report);
+/// The human summary of a pressure-volume curve (a curve job): its points, extrema and stop reason.
+std::string curve_summary(const balloon::v1::CurveReport& report);
 
 }  // namespace balloon::cli

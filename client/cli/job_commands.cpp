@@ -144,8 +144,9 @@ int watch(ServiceConnection& service, const std::string& job_id, const ParsedArg
     grpc::Status status;
     Result<v1::JobResult> result = fetch_result(service, job_id, v1::MESH_FORMAT_OBJ, &status);
     if (!result) return report_error(command, result.error(), exit_code_for(status));
-    std::cout << (job.kind() == v1::JOB_KIND_DESIGN ? design_summary(result->design_report(), "")
-                                                    : simulate_summary(result->simulate_report()))
+    std::cout << (job.kind() == v1::JOB_KIND_DESIGN  ? design_summary(result->design_report(), "")
+                  : job.kind() == v1::JOB_KIND_CURVE ? curve_summary(result->curve_report())
+                                                     : simulate_summary(result->simulate_report()))
               << std::flush;
     std::fprintf(stderr, "files: %s jobs result %s --out-dir DIR\n", command_prefix(global.connection).c_str(),
                  job_id.c_str());

@@ -2,7 +2,9 @@
 /// a job through the service (embedded by default, or --server).
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <sstream>
 
@@ -25,7 +27,9 @@ constexpr const char* COMMAND = "simulate";
 
 constexpr const char* HELP =
     "Usage: balloon simulate REST_MESH --material SPEC [--thickness MM]\n"
-    "                        (--pressure KPA | --volume-ratio R) [--out FILE] [--json]\n\n"
+    "                        (--pressure KPA | --volume-ratio R) [--out FILE] [--json]\n"
+    "       balloon simulate REST_MESH --material SPEC [--thickness MM]\n"
+    "                        (--volume-ratio-range A:B | --pressure-range A:B) --points N [--out PATH] [--json]\n\n"
     "Inflates the closed rest mesh REST_MESH (OBJ, STL, PLY, OFF, glTF/GLB; coordinates in mm) to\n"
     "static equilibrium, either under a given pressure or to a given enclosed-volume ratio. Runs as a job\n"
     "on the service (an embedded one unless --server is given); on a terminal, progress goes to stderr.\n\n"
@@ -36,14 +40,36 @@ constexpr const char* HELP =
     "  --thickness MM      rest membrane thickness in mm (default 0.5)\n"
     "  --pressure KPA      inflate under this pressure (kPa, > 0)\n"
     "  --volume-ratio R    inflate until V / V_rest = R (> 0); passes pressure maxima\n"
+    "  --volume-ratio-range A:B\n"
+    "                      the whole pressure-volume curve: N equilibria with V / V_rest from A to B\n"
+    "                      (1 < A < B <= 1e6), spaced geometrically (equal ratios), followed as ONE\n"
+    "                      continuation path (each point starts from the previous equilibrium; passes\n"
+    "                      pressure maxima)\n"
+    "  --pressure-range A:B\n"
+    "                      the same over pressures A..B kPa (0 < A < B <= 1e6), spaced geometrically; under\n"
+    "                      pressure control the path ends at the first pressure above a pressure maximum\n"
+    "  --points N          number of curve points, 2..1000\n"
     "  --out FILE          write the inflated mesh (.obj, .stl or .ply), only if the run converged\n"
+    "                      A curve writes curve.csv and curve.svg into FILE's folder (into FILE if it is a\n"
+    "                      directory; the current folder without --out) and, if FILE ends in .obj, .stl or\n"
+    "                      .ply, the last converged equilibrium to FILE\n"
     "  --json              print one JSON object on stdout instead of a summary\n"
     "  --help              this text\n\n"
     "JSON: the message balloon.v1.SimulateReport of proto/balloon/v1/balloon.proto in protobuf's JSON\n"
-    "mapping (field names as in the .proto).\n\n"
-    "Exit codes: 0 converged, 2 bad input (one line on stderr names it), 3 not converged (the result is\n"
-    "still printed, no --out file), 5 server unreachable or busy, 6 not allowed, 8 the job failed,\n"
-    "130 interrupted (the job keeps running), 1 internal error.\n\n";
+    "mapping (field names as in the .proto); for a curve, balloon.v1.CurveReport: `points` (one object per\n"
+    "point: target, converged, volume_ratio, pressure_kpa, mean_stretch, max_stretch, unstable_modes,\n"
+    "message) and `extrema` (kind maximum|minimum, point, volume_ratio, pressure_kpa).\n\n"
+    "curve.csv: volume_ratio,pressure_kpa,mean_stretch,max_stretch,unstable_modes,converged; one row per\n"
+    "point in path order (pressure in kPa, stretches and ratio dimensionless); a value never computed is\n"
+    "an empty cell. unstable_modes: negative eigen-directions of the stiffness at the equilibrium (volume\n"
+    "control: of the volume-constrained system; 0 = stable). The first point without an equilibrium ends\n"
+    "the path: it and every later point are rows with converged=false (report.json's message says why).\n"
+    "curve.svg: pressure against volume ratio (log scale), pressure maxima and minima marked.\n\n"
+    "Exit codes: 0 converged (a curve: every point), 2 bad input (one line on stderr names it),\n"
+    "3 not converged (the result is still printed, no --out mesh; a curve still writes curve.csv and\n"
+    "curve.svg),\n"
+    "5 server unreachable or busy, 6 not allowed, 8 the job failed, 130 interrupted (the job keeps\n"
+    "running), 1 internal error.\n\n";
 
 std::string format(const char* pattern, double value) {
   char buffer[64];
@@ -90,15 +116,103 @@ Result<PreparedJob> prepare_simulate(const std::vector<std::string>& args) {
   return job;
 }
 
+bool is_curve(const PreparedJob& job) { return job.request.spec().simulate().has_curve(); }
+
+bool names_mesh(const std::string& path) {
+  const v1::MeshFormat format = mesh_format_from_path(path);
+  return format == v1::MESH_FORMAT_OBJ || format == v1::MESH_FORMAT_STL || format == v1::MESH_FORMAT_PLY;
+}
+
+/// Where a curve's files go: --out's folder (--out itself if it is a directory), the current folder without it.
+std::filesystem::path curve_folder(const std::optional<std::string>& out_path) {
+  if (!out_path) return ".";
+  std::error_code error;
+  if (std::filesystem::is_directory(*out_path, error)) return *out_path;
+  const std::filesystem::path parent = std::filesystem::path(*out_path).parent_path();
+  return parent.empty() ? std::filesystem::path(".") : parent;
+}
+
+std::string check_curve_outputs(const PreparedJob& job) {
+  const std::optional<std::string> out_path = job.args.get("out");
+  const std::filesystem::path folder = curve_folder(out_path);
+  std::error_code error;
+  if (!std::filesystem::is_directory(folder, error))
+    return "--out: folder '" + folder.string() + "' does not exist";
+  if (::access(folder.c_str(), W_OK) != 0) return "--out: folder '" + folder.string() + "' is not writable";
+  return "";
+}
+
 std::string check_simulate_outputs(const PreparedJob& job) {
+  if (is_curve(job)) return check_curve_outputs(job);
   if (const auto out_path = job.args.get("out")) {
     if (const std::string problem = mesh_output_problem(*out_path); !problem.empty()) return "--out: " + problem;
   }
   return "";
 }
 
+/// The human summary of a curve: one line per point, the extrema, the stop reason.
+std::string summary_from_curve(const v1::CurveReport& report) {
+  std::ostringstream out;
+  int converged = 0;
+  for (const v1::CurvePointReport& point : report.points()) converged += point.converged() ? 1 : 0;
+  out << (report.converged() ? "converged" : "NOT converged") << ": " << converged << " of " << report.points_size()
+      << " points on one path (" << report.newton_iterations() << " Newton iterations, " << report.factorizations()
+      << " factorizations) in " << format("%.3f", report.time_s()) << " s\n";
+  if (!report.converged()) out << "  " << report.message() << "\n";
+  out << "  material       " << report.material();
+  if (!report.material_name().empty()) out << " (" << report.material_name() << ")";
+  out << ", thickness " << format("%.6g", report.thickness_mm()) << " mm, " << report.vertices() << " vertices\n";
+  out << "     V/V0    p (kPa)  mean stretch  max stretch  unstable\n";
+  for (const v1::CurvePointReport& point : report.points()) {
+    if (!point.converged()) {
+      out << "  " << format("%7.4g", point.target()) << "  " << point.message() << "\n";
+      continue;
+    }
+    out << "  " << format("%7.4g", point.volume_ratio()) << "  " << format("%9.5g", point.pressure_kpa()) << "  "
+        << format("%12.5g", point.mean_stretch()) << "  " << format("%11.5g", point.max_stretch()) << "  "
+        << (point.has_unstable_modes() ? format("%8.0f", point.unstable_modes()) : std::string("       ?")) << "\n";
+  }
+  for (const v1::CurveExtremumReport& extremum : report.extrema())
+    out << "  pressure " << extremum.kind() << " " << format("%.4g", extremum.pressure_kpa()) << " kPa at V/V0 "
+        << format("%.4g", extremum.volume_ratio()) << " (stretch " << format("%.4g", std::cbrt(extremum.volume_ratio()))
+        << ")\n";
+  return out.str();
+}
+
+int finish_curve(ServiceConnection& connection, const PreparedJob& job, const std::string& job_id,
+                 const GlobalOptions& global) {
+  const std::optional<std::string> out_path = job.args.get("out");
+  const bool write_mesh = out_path && names_mesh(*out_path);
+  grpc::Status status;
+  Result<v1::JobResult> result = fetch_result(
+      connection, job_id, write_mesh ? mesh_format_from_path(*out_path) : v1::MESH_FORMAT_OBJ, &status);
+  if (!result) return report_error(COMMAND, result.error(), exit_code_for(status));
+  const std::filesystem::path folder = curve_folder(out_path);
+  for (const contract::JobResultFile& file : contract::job_result_files(*result)) {
+    if (file.name != "curve.csv" && file.name != "curve.svg") continue;
+    Result<bool> written = write_file_atomically((folder / file.name).string(), file.bytes);
+    if (!written) return report_error(COMMAND, file.name + ": " + written.error(), EXIT_INTERNAL);
+  }
+  if (global.json)
+    std::cout << contract::result_report_json(*result) << std::flush;
+  else
+    std::cout << summary_from_curve(result->curve_report()) << "  files          " << (folder / "curve.csv").string()
+              << ", " << (folder / "curve.svg").string() << "\n"
+              << std::flush;
+  if (write_mesh) {
+    if (result->curve_report().last_converged_point() < 0) {
+      std::fprintf(stderr, "balloon simulate: no point converged; %s not written\n", out_path->c_str());
+    } else {
+      Result<bool> written = write_file_atomically(*out_path, result->inflated_mesh().data());
+      if (!written) return report_error(COMMAND, "--out: " + written.error(), EXIT_INTERNAL);
+    }
+  }
+  return result->converged() ? EXIT_OK : EXIT_NOT_CONVERGED;
+}
+
 int finish_simulate(ServiceConnection& connection, const PreparedJob& job, const std::string& job_id,
                     const GlobalOptions& global) {
+  if (is_curve(job)) return finish_curve(connection, job, job_id, global);
   const std::optional<std::string> out_path = job.args.get("out");
   grpc::Status status;
   Result<v1::JobResult> result =
@@ -125,6 +239,8 @@ int finish_simulate(ServiceConnection& connection, const PreparedJob& job, const
 }  // namespace
 
 std::string simulate_summary(const v1::SimulateReport& report) { return summary_from_report(report); }
+
+std::string curve_summary(const v1::CurveReport& report) { return summary_from_curve(report); }
 
 const JobCommand& simulate_job_command() {
   static const JobCommand PARTS{"simulate", HELP, {"out"}, prepare_simulate, check_simulate_outputs, finish_simulate};

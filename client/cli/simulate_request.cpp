@@ -14,8 +14,24 @@
 namespace balloon::cli {
 
 std::vector<OptionSpec> simulate_option_specs() {
-  return {{"material"}, {"thickness"}, {"pressure"}, {"volume-ratio"}};
+  return {{"material"}, {"thickness"}, {"pressure"}, {"volume-ratio"}, {"volume-ratio-range"}, {"pressure-range"}, {"points"}};
 }
+
+namespace {
+
+/// "A:B" as two finite numbers, or an error naming the option.
+Result<std::pair<double, double>> parse_range(const std::string& option, const std::string& text) {
+  const std::size_t colon = text.find(':');
+  if (colon == std::string::npos || text.find(':', colon + 1) != std::string::npos)
+    return fail("--" + option + ": '" + text + "' is not a range A:B");
+  Result<double> from = parse_number(option, text.substr(0, colon));
+  if (!from) return fail(from.error());
+  Result<double> to = parse_number(option, text.substr(colon + 1));
+  if (!to) return fail(to.error());
+  return std::make_pair(*from, *to);
+}
+
+}  // namespace
 
 balloon::v1::MeshFormat mesh_format_from_path(const std::string& path) {
   std::string extension = std::filesystem::path(path).extension().string();
@@ -61,11 +77,40 @@ Result<balloon::v1::SubmitJobRequest> simulate_request_from_args(const ParsedArg
     if (!value) return fail(value.error());
     parameters.volume_ratio = *value;
   }
+  const std::optional<std::string> volume_range = args.get("volume-ratio-range");
+  const std::optional<std::string> pressure_range = args.get("pressure-range");
+  if (volume_range && pressure_range) return fail("give --volume-ratio-range or --pressure-range, not both");
+  if (volume_range || pressure_range) {
+    const char* option = volume_range ? "volume-ratio-range" : "pressure-range";
+    Result<std::pair<double, double>> range = parse_range(option, volume_range ? *volume_range : *pressure_range);
+    if (!range) return fail(range.error());
+    const std::optional<std::string> points_text = args.get("points");
+    if (!points_text) return fail("--points N is needed with --" + std::string(option));
+    // Bounded by the job's own check (its message names the limits); this only keeps the int in range.
+    Result<long long> points = parse_integer("points", *points_text, -1000000, 1000000);
+    if (!points) return fail(points.error());
+    jobs::CurveParameters curve;
+    curve.control = volume_range ? InflationControl::VolumeRatio : InflationControl::Pressure;
+    curve.from = range->first;
+    curve.to = range->second;
+    curve.points = static_cast<int>(*points);
+    parameters.curve = curve;
+  } else if (args.has("points")) {
+    return fail("--points needs --volume-ratio-range or --pressure-range");
+  }
   if (const std::vector<jobs::FieldProblem> problems = jobs::simulate_parameter_problems(parameters); !problems.empty())
     return fail(message_naming_flags("simulate", problems));
   job->set_thickness_mm(parameters.thickness_mm);
   if (parameters.pressure_kpa) job->set_pressure_kpa(*parameters.pressure_kpa);
   if (parameters.volume_ratio) job->set_volume_ratio(*parameters.volume_ratio);
+  if (const auto& curve = parameters.curve) {
+    balloon::v1::ValueRange* range = curve->control == InflationControl::VolumeRatio
+                                         ? job->mutable_curve()->mutable_volume_ratio_range()
+                                         : job->mutable_curve()->mutable_pressure_range();
+    range->set_from(curve->from);
+    range->set_to(curve->to);
+    job->mutable_curve()->set_points(curve->points);
+  }
 
   const balloon::v1::MeshFormat format = mesh_format_from_path(mesh_path);
   std::error_code error;

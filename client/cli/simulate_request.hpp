@@ -10,7 +10,8 @@
 
 namespace balloon::cli {
 
-/// --material, --thickness, --pressure, --volume-ratio.
+/// --material, --thickness, --pressure, --volume-ratio, and for a curve --volume-ratio-range or
+/// --pressure-range with --points.
 std::vector<OptionSpec> simulate_option_specs();
 
 /// Checks REST_MESH (one positional) and the flags, reads the mesh file, and builds the request.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 
@@ -10,6 +11,7 @@
 #include "mesh/self_intersection.hpp"
 #include "solve/equilibrium_solver.hpp"
 #include "solve/rigid_modes.hpp"
+#include "solve/sparse_solver.hpp"
 
 namespace balloon {
 namespace {
@@ -43,6 +45,26 @@ struct PathPoint {
   double volume = 0.0;
 };
 
+/// The inertia of the exact stiffness, for states EquilibriumSolver's positive definite test rejects:
+/// its own assembly and simplicial LDL^T, so the solver's factorization and state are left alone.
+class Inertia {
+ public:
+  Inertia(const fem::BalloonModel& model, const std::vector<bool>& fixed)
+      : m_assembly(model.faces(), model.vertex_count(), fixed) {
+    m_solver.set_pattern(m_assembly.free_count(), m_assembly.column_starts(), m_assembly.row_indices());
+  }
+  /// Negative eigenvalues of Hess(W - p V) at x; -1 when it is singular.
+  int negative_eigenvalues(const fem::BalloonModel& model, const Eigen::VectorXd& x, double pressure_mpa) {
+    model.assemble_hessian(x, pressure_mpa, m_assembly, false);
+    if (m_solver.factorize_ldlt(m_assembly.values()) != SparseSolver::Status::Ok) return -1;
+    return m_solver.negative_pivots();
+  }
+
+ private:
+  fem::TriangleAssembly m_assembly;
+  SparseSolver m_solver;
+};
+
 class InflationRun {
  public:
   InflationRun(const TriMesh& rest, const InflationOptions& options)
@@ -60,31 +82,61 @@ class InflationRun {
   }
 
   InflationResult run(const Positions* initial_guess) {
-    InflationResult result;
+    start(initial_guess);
+    return advance(m_options.control,
+                   m_options.control == InflationControl::VolumeRatio ? m_options.volume_ratio : m_options.pressure_kpa);
+  }
+
+  /// Sets the path's first state: the rest shape, or `initial_guess` (#V by 3, mm). Empty when usable,
+  /// else why not (the rest mesh encloses no volume).
+  std::string start(const Positions* initial_guess) {
     const Eigen::Map<const Eigen::VectorXd> rest_flat(m_rest.vertices.data(), m_rest.vertices.size());
-    result.rest_volume_mm3 = m_model.volume(rest_flat);
-    PathPoint state{rest_flat, 0.0, result.rest_volume_mm3};
-    bool ok = true;
-    if (!(result.rest_volume_mm3 > 0.0)) {
-      ok = false;
+    m_rest_volume = m_model.volume(rest_flat);
+    m_state = PathPoint{rest_flat, 0.0, m_rest_volume};
+    if (!(m_rest_volume > 0.0)) {
+      m_problem = "the rest mesh encloses no positive volume (open, flat or oriented inwards)";
+    } else if (initial_guess) {
+      m_state.x = Eigen::Map<const Eigen::VectorXd>(initial_guess->data(), initial_guess->size());
+      m_state.volume = m_model.volume(m_state.x);
+      m_state.pressure = estimate_pressure(m_state.x);
+    }
+    return m_problem;
+  }
+
+  /// Continues the path from its current state to `target` (V / V_rest, or kPa under pressure control).
+  /// A failed advance leaves the state at the last equilibrium the volume path reached.
+  InflationResult advance(InflationControl control, double target) {
+    InflationResult result;
+    result.rest_volume_mm3 = m_rest_volume;
+    m_stop = InflationStop::NoEquilibrium;
+    bool ok = false;
+    if (!m_problem.empty()) {
       m_stop = InflationStop::InvalidInput;
-      result.message = "the rest mesh encloses no positive volume (open, flat or oriented inwards)";
+      result.message = m_problem;
+    } else if (control == InflationControl::VolumeRatio) {
+      ok = inflate_to_volume(m_state, target * m_rest_volume, result.message);
     } else {
-      if (initial_guess) {
-        state.x = Eigen::Map<const Eigen::VectorXd>(initial_guess->data(), initial_guess->size());
-        state.volume = m_model.volume(state.x);
-        state.pressure = estimate_pressure(state.x);
-      }
-      if (m_options.control == InflationControl::VolumeRatio)
-        ok = inflate_to_volume(state, m_options.volume_ratio * result.rest_volume_mm3, result.message);
-      else
-        ok = inflate_to_pressure(state, m_options.pressure_kpa * MPA_PER_KPA, result.message);
+      ok = inflate_to_pressure(m_state, target * MPA_PER_KPA, result.message);
     }
     result.converged = ok;
     result.stop = ok ? InflationStop::Converged : m_stop;
     if (ok) result.message = "converged";
-    fill(result, state);
+    fill(result, m_state);
     return result;
+  }
+
+  /// Continuation predictor for a path of many targets (InflationPath): the shape secant below, and the
+  /// least-squares pressure of the predicted shape rather than the last pressure. Together they save
+  /// about one Newton step per curve point.
+  void use_path_predictor() { m_path_predictor = true; }
+
+  /// Unstable directions of the current state under pressure control: the negative eigenvalues of the
+  /// stiffness K = Hess(W - p V) over the free coordinates (0 when K is positive definite). One
+  /// supernodal LL^T; the simplicial LDL^T for the inertia only when that fails. -1 when K is singular.
+  int pressure_unstable_modes() {
+    if (m_solver.factorize_at(m_state.x, m_state.pressure)) return 0;
+    if (!m_inertia) m_inertia = std::make_unique<Inertia>(m_model, m_fixed);
+    return m_inertia->negative_eigenvalues(m_model, m_state.x, m_state.pressure);
   }
 
  private:
@@ -139,6 +191,20 @@ class InflationRun {
     return y;
   }
 
+  /// Path predictor: the scaled guess plus the change of shape beyond scaling over the last step, carried
+  /// on in proportion to log V (a secant on the deviation from a sphere's self-similar growth). On a
+  /// discrete sphere it takes the Newton step that the uneven stretch of the polyhedron would cost.
+  void add_shape_secant(const PathPoint& state, double target_volume, Eigen::VectorXd& x) const {
+    if (has_user_fixed_vertices() || m_previous.x.size() != state.x.size()) return;
+    if (!(m_previous.volume > 0.0) || !(state.volume > m_previous.volume * (1.0 + 1e-12))) return;
+    const double theta = std::log(target_volume / state.volume) / std::log(state.volume / m_previous.volume);
+    if (!(theta > 0.0) || theta > 4.0) return;
+    const double s = std::cbrt(target_volume / state.volume);
+    const Eigen::VectorXd deviation = state.x - predict(m_previous.x, state.volume);
+    if (!deviation.allFinite()) return;
+    x += theta * s * deviation;
+  }
+
   void report_progress(const PathPoint& state, double residual, bool with_shape) {
     if (!m_options.progress) return;
     ProgressEvent event;
@@ -160,6 +226,10 @@ class InflationRun {
   bool volume_step(PathPoint& state, double target_volume, NewtonReport& report, const PathPoint* resume = nullptr) {
     Eigen::VectorXd x = resume ? resume->x : predict(state.x, target_volume);
     double pressure = resume ? resume->pressure : state.pressure;
+    if (m_path_predictor && !resume) {
+      add_shape_secant(state, target_volume, x);
+      pressure = estimate_pressure(x);
+    }
     if (pressure == 0.0) pressure = estimate_pressure(x);
     m_unfinished_start_residual = m_solver.residual(x, pressure).norm();
     report = m_solver.solve_volume(x, pressure, target_volume, m_settings);
@@ -168,6 +238,7 @@ class InflationRun {
       m_unfinished = {x, pressure, target_volume};
       return false;
     }
+    if (m_path_predictor) m_previous = state;
     state = {x, pressure, target_volume};
     m_unstable_modes = report.unstable_modes;
     ++m_load_steps;
@@ -323,6 +394,12 @@ class InflationRun {
   PathPoint m_unfinished;                   ///< where the last failed attempt ended
   double m_unfinished_start_residual = 0.0;  ///< N, the residual that attempt started from
   InflationStop m_stop = InflationStop::NoEquilibrium;
+  PathPoint m_state;
+  double m_rest_volume = 0.0;
+  std::string m_problem;  ///< why the path cannot start; empty when it can
+  std::unique_ptr<Inertia> m_inertia;  ///< made on first use
+  bool m_path_predictor = false;  ///< see use_path_predictor()
+  PathPoint m_previous;  ///< the equilibrium before the current state (path predictor)
 };
 
 std::string options_problem(const TriMesh& rest, const InflationOptions& options) {
@@ -374,6 +451,48 @@ const char* inflation_stop_word(InflationStop stop) {
   }
   return "unknown";
 }
+
+struct InflationPath::Impl {
+  Impl(const TriMesh& rest_mesh, const InflationOptions& path_options)
+      : rest(rest_mesh), options(path_options), problem(options_problem(rest, options)) {
+    if (problem.empty()) {
+      run = std::make_unique<InflationRun>(rest, options);
+      run->use_path_predictor();
+    }
+  }
+  TriMesh rest;  // copies: the run keeps references to both
+  InflationOptions options;
+  std::string problem;
+  std::unique_ptr<InflationRun> run;
+};
+
+InflationPath::InflationPath(const TriMesh& rest, const InflationOptions& options, const Positions* initial_guess) {
+  InflationOptions checked = options;
+  // The targets are checked per advance; give options_problem harmless ones.
+  checked.control = InflationControl::VolumeRatio;
+  checked.volume_ratio = 1.0;
+  m = std::make_unique<Impl>(rest, checked);
+  if (m->run) m->problem = m->run->start(initial_guess);
+}
+
+InflationPath::~InflationPath() = default;
+
+InflationResult InflationPath::advance(InflationControl control, double target) {
+  std::string problem = m->problem;
+  if (problem.empty() && !(target > 0.0 && std::isfinite(target)))
+    problem = control == InflationControl::Pressure ? "pressure must be a positive number (kPa)"
+                                                    : "volume ratio must be a positive number";
+  if (!problem.empty()) {
+    InflationResult result;
+    result.stop = InflationStop::InvalidInput;
+    result.message = problem;
+    result.deformed = m->rest.vertices;
+    return result;
+  }
+  return m->run->advance(control, target);
+}
+
+int InflationPath::pressure_unstable_modes() { return m->run ? m->run->pressure_unstable_modes() : -1; }
 
 InflationResult inflate(const TriMesh& rest, const InflationOptions& options, const Positions* initial_guess) {
   if (auto problem = options_problem(rest, options); !problem.empty()) {

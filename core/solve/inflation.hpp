@@ -1,6 +1,7 @@
 #pragma once
 /// Static inflation of a closed membrane: the equilibrium shape under a given pressure, or at a given
 /// enclosed volume with the pressure as an unknown (volume control passes pressure maxima).
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -75,5 +76,31 @@ struct InflationResult {
 /// the solve; without it the rest shape scaled about its centroid is used.
 InflationResult inflate(const TriMesh& rest, const InflationOptions& options,
                         const Positions* initial_guess = nullptr);
+
+/// One inflation path followed target after target: each advance starts from the last equilibrium and
+/// reuses the model, the sparsity pattern and CHOLMOD's analysis (the pressure-volume curve's path).
+class InflationPath {
+ public:
+  /// `options` as for inflate(); its control and targets are ignored (each advance names its own).
+  /// `initial_guess` as for inflate().
+  InflationPath(const TriMesh& rest, const InflationOptions& options, const Positions* initial_guess = nullptr);
+  ~InflationPath();
+  InflationPath(const InflationPath&) = delete;
+  InflationPath& operator=(const InflationPath&) = delete;
+
+  /// Continues to V / V_rest = target (VolumeRatio) or to the pressure target (kPa, Pressure). Counters
+  /// and time in the result are totals since construction. Not converged: the state stays at the last
+  /// equilibrium the volume path reached, and the result says why (InvalidInput for rejected options).
+  InflationResult advance(InflationControl control, double target);
+
+  /// Unstable directions of the last state under pressure control: negative eigenvalues of the
+  /// stiffness Hess(W - p V) over the free coordinates (0 = stable); -1 when it is singular. Under volume
+  /// control the result's unstable_modes counts them for the bordered (volume-constrained) system.
+  int pressure_unstable_modes();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> m;
+};
 
 }  // namespace balloon

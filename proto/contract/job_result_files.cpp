@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 
+#include "contract/curve_files.hpp"
 #include "contract/report_json.hpp"
 
 namespace balloon::contract {
@@ -32,6 +33,7 @@ std::string result_report_json(const v1::JobResult& result) {
     case v1::JobResult::kSimulateReport: return report_json(result.simulate_report());
     case v1::JobResult::kDesignReport: return report_json(result.design_report());
     case v1::JobResult::kFitReport: return report_json(result.fit_report());
+    case v1::JobResult::kCurveReport: return report_json(result.curve_report());
     case v1::JobResult::REPORT_NOT_SET: break;
   }
   return "{}\n";
@@ -62,6 +64,10 @@ std::vector<JobResultFile> job_result_files(const v1::JobResult& result) {
   files.push_back({"report.json", result_report_json(result)});
   if (result.kind() == v1::JOB_KIND_DESIGN)
     files.push_back({"convergence.csv", convergence_csv(result.design_report().convergence())});
+  if (result.kind() == v1::JOB_KIND_CURVE) {
+    files.push_back({"curve.csv", curve_csv(result.curve_report())});
+    files.push_back({"curve.svg", curve_svg(result.curve_report())});
+  }
   return files;
 }
 

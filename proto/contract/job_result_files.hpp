@@ -22,6 +22,8 @@ std::string result_mesh_extension(balloon::v1::MeshFormat format);
 ///   design:        rest.EXT, inflated.EXT, mold.stl (only when the server built a mold), report.json,
 ///                  convergence.csv
 ///   simulate:      rest.EXT, inflated.EXT, report.json
+///   curve:         rest.EXT, inflated.EXT (the last converged point), report.json, curve.csv, curve.svg
+///                  (contract/curve_files)
 ///   fit-material:  report.json, fit.svg
 /// report.json is report_json() of the result's report; convergence.csv is convergence_csv() of the
 /// design report's log; mold.stl is the server's mold_mesh as it came.

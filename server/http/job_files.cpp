@@ -12,11 +12,11 @@ JobFile missing(const std::string& message) { return {grpc::Status(grpc::StatusC
 
 }  // namespace
 
-const char* const JOB_FILE_NAMES = "rest.obj, inflated.obj, mold.stl, report.json, convergence.csv or fit.svg";
+const char* const JOB_FILE_NAMES = "rest.obj, inflated.obj, mold.stl, report.json, convergence.csv, fit.svg, curve.csv or curve.svg";
 
 bool is_job_file_name(const std::string& name) {
   return name == "rest.obj" || name == "inflated.obj" || name == "mold.stl" || name == "report.json" ||
-         name == "convergence.csv" || name == "fit.svg";
+         name == "convergence.csv" || name == "fit.svg" || name == "curve.csv" || name == "curve.svg";
 }
 
 JobFile job_file(const v1::JobResult& result, const std::string& name) {
@@ -34,6 +34,8 @@ JobFile job_file(const v1::JobResult& result, const std::string& name) {
   }
   if (name == "convergence.csv") return missing(job + " is not a design: convergence.csv exists for designs only");
   if (name == "fit.svg") return missing(job + " is not a material fit: fit.svg exists for material fits only");
+  if (name == "curve.csv" || name == "curve.svg")
+    return missing(job + " is not a curve: " + name + " exists for pressure-volume curves only");
   return missing(std::string("unknown file '") + name + "': " + JOB_FILE_NAMES);
 }
 

@@ -21,14 +21,26 @@ std::vector<FieldProblem> simulate_parameter_problems(const SimulateParameters& 
   std::vector<FieldProblem> problems;
   if (!std::isfinite(parameters.thickness_mm) || parameters.thickness_mm <= 0.0)
     problems.push_back({"thickness_mm", "thickness must be a positive number of mm, got " + format_number(parameters.thickness_mm)});
-  if (parameters.pressure_kpa && parameters.volume_ratio)
-    problems.push_back({"pressure_kpa", "give either a pressure or a volume ratio, not both"});
-  else if (!parameters.pressure_kpa && !parameters.volume_ratio)
-    problems.push_back({"pressure_kpa", "give a pressure (kPa) or a volume ratio"});
+  const int controls = (parameters.pressure_kpa ? 1 : 0) + (parameters.volume_ratio ? 1 : 0) + (parameters.curve ? 1 : 0);
+  if (controls > 1)
+    problems.push_back({"pressure_kpa", parameters.curve ? "give a curve range or a single pressure or volume ratio, not both"
+                                                         : "give either a pressure or a volume ratio, not both"});
+  else if (controls == 0)
+    problems.push_back({"pressure_kpa", "give a pressure (kPa) or a volume ratio (or a curve range)"});
   else if (parameters.pressure_kpa && (!std::isfinite(*parameters.pressure_kpa) || *parameters.pressure_kpa <= 0.0))
     problems.push_back({"pressure_kpa", "pressure must be a positive number of kPa, got " + format_number(*parameters.pressure_kpa)});
   else if (parameters.volume_ratio && (!std::isfinite(*parameters.volume_ratio) || *parameters.volume_ratio <= 0.0))
     problems.push_back({"volume_ratio", "volume ratio must be a positive number, got " + format_number(*parameters.volume_ratio)});
+  else if (parameters.curve) {
+    const CurveParameters* curve = &*parameters.curve;
+    // The range and the point count each by their own field: check the range with a valid count.
+    const std::string range = curve_range_problem(curve->control, curve->from, curve->to, MIN_CURVE_POINTS);
+    if (!range.empty())
+      problems.push_back(
+          {curve->control == InflationControl::Pressure ? "curve.pressure_range" : "curve.volume_ratio_range", range});
+    if (curve->points < MIN_CURVE_POINTS || curve->points > MAX_CURVE_POINTS)
+      problems.push_back({"curve.points", curve_range_problem(curve->control, 2.0, 3.0, curve->points)});
+  }
   return problems;
 }
 
@@ -47,10 +59,11 @@ Result<SimulateInput> prepare_simulate(TriMesh rest, const Material& material,
   input.rest = std::move(rest);
   input.material = material;
   input.thickness_mm = parameters.thickness_mm;
+  input.curve = parameters.curve;
   if (parameters.pressure_kpa) {
     input.control = InflationControl::Pressure;
     input.pressure_kpa = *parameters.pressure_kpa;
-  } else {
+  } else if (parameters.volume_ratio) {
     input.control = InflationControl::VolumeRatio;
     input.volume_ratio = *parameters.volume_ratio;
   }
@@ -72,6 +85,22 @@ SimulateOutcome run_simulate(const SimulateInput& input, const RunControls& cont
   outcome.result = inflate(input.rest, options);
   outcome.cancelled = controls.cancel != nullptr && controls.cancel->cancelled() && !outcome.result.converged;
   return outcome;
+}
+
+PressureVolumeCurve run_curve(const SimulateInput& input, const RunControls& controls) {
+  PressureVolumeCurveOptions options;
+  options.material = input.material;
+  options.thickness_mm = input.thickness_mm;
+  if (input.curve) {
+    options.control = input.curve->control;
+    options.from = input.curve->from;
+    options.to = input.curve->to;
+    options.points = input.curve->points;
+  }
+  options.max_time_s = controls.max_time_s;
+  options.progress = controls.progress;
+  options.cancel = controls.cancel;
+  return trace_pressure_volume_curve(input.rest, options);
 }
 
 }  // namespace balloon::jobs

@@ -11,17 +11,28 @@
 #include "progress.hpp"
 #include "result.hpp"
 #include "solve/inflation.hpp"
+#include "solve/pressure_volume_curve.hpp"
 
 namespace balloon::jobs {
 
 /// Default rest membrane thickness (mm) when a request names none.
 inline constexpr double DEFAULT_THICKNESS_MM = 0.5;
 
-/// How a user asked to load the membrane. Exactly one of pressure_kpa and volume_ratio is set.
+/// A pressure-volume curve request (SimulateJob.curve): `points` targets spaced geometrically over
+/// from..to, V / V_rest under volume control or kPa under pressure control.
+struct CurveParameters {
+  InflationControl control = InflationControl::VolumeRatio;
+  double from = 0.0;
+  double to = 0.0;
+  int points = 0;
+};
+
+/// How a user asked to load the membrane. Exactly one of pressure_kpa, volume_ratio and curve is set.
 struct SimulateParameters {
   double thickness_mm = DEFAULT_THICKNESS_MM;  ///< rest thickness h (mm), > 0
   std::optional<double> pressure_kpa;          ///< pressure control (kPa), > 0
   std::optional<double> volume_ratio;          ///< volume control: target V / V_rest, > 0
+  std::optional<CurveParameters> curve;        ///< the whole curve in one run
 };
 
 /// A simulate job whose inputs have all been checked: ready to run.
@@ -33,10 +44,12 @@ struct SimulateInput {
   InflationControl control = InflationControl::VolumeRatio;
   double pressure_kpa = 0.0;        ///< pressure control target (kPa)
   double volume_ratio = 1.0;        ///< volume control target V / V_rest
+  std::optional<CurveParameters> curve;  ///< set for a curve job (control and targets above unused)
 };
 
 /// Empty when the parameters are usable, else one problem per bad field, named by its SimulateJob field
-/// ("thickness_mm", "pressure_kpa" when neither or both controls are given, "volume_ratio").
+/// ("thickness_mm", "pressure_kpa" when no or several controls are given, "volume_ratio",
+/// "curve.volume_ratio_range" or "curve.pressure_range" for a bad range, "curve.points").
 std::vector<FieldProblem> simulate_parameter_problems(const SimulateParameters& parameters);
 
 /// Checks the parameters, the material constants and the mesh (closed, manifold, finite, ...); an
@@ -59,5 +72,8 @@ struct SimulateOutcome {
 
 /// Inflates a prepared job. Never throws for non-convergence: that is `result.converged == false`.
 SimulateOutcome run_simulate(const SimulateInput& input, const RunControls& controls);
+
+/// Follows the pressure-volume curve of a prepared curve job (input.curve set) in one path.
+PressureVolumeCurve run_curve(const SimulateInput& input, const RunControls& controls);
 
 }  // namespace balloon::jobs

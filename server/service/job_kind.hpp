@@ -109,8 +109,10 @@ bool names_stored_material(const balloon::v1::MaterialRef& reference);
 }  // namespace balloon::service
 
 namespace balloon::service {
-/// The kinds (one file each: simulate_kind.cpp, design_kind.cpp, fit_material_kind.cpp).
+/// The kinds (one file each: simulate_kind.cpp, design_kind.cpp, fit_material_kind.cpp, curve_kind.cpp).
 const JobKind& simulate_kind();
 const JobKind& design_kind();
 const JobKind& fit_material_kind();
+/// A simulate job with SimulateJob.curve (curve_kind.cpp).
+const JobKind& curve_kind();
 }  // namespace balloon::service

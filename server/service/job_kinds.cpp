@@ -21,6 +21,7 @@ google::protobuf::Message* report_of(v1::JobKind kind, v1::JobResult* reply) {
     case v1::JOB_KIND_SIMULATE: return reply->mutable_simulate_report();
     case v1::JOB_KIND_DESIGN: return reply->mutable_design_report();
     case v1::JOB_KIND_FIT_MATERIAL: return reply->mutable_fit_report();
+    case v1::JOB_KIND_CURVE: return reply->mutable_curve_report();
     default: return nullptr;
   }
 }
@@ -59,7 +60,8 @@ Result<std::string> mold_stl(const store::ResultRecord& stored, const TriMesh& r
 
 const JobKind* job_kind_for(const v1::JobSpec& spec) {
   switch (spec.kind_case()) {
-    case v1::JobSpec::kSimulate: return &simulate_kind();
+    case v1::JobSpec::kSimulate:
+      return spec.simulate().control_case() == v1::SimulateJob::kCurve ? &curve_kind() : &simulate_kind();
     case v1::JobSpec::kDesign: return &design_kind();
     case v1::JobSpec::kFitMaterial: return &fit_material_kind();
     case v1::JobSpec::KIND_NOT_SET: return nullptr;
@@ -68,7 +70,7 @@ const JobKind* job_kind_for(const v1::JobSpec& spec) {
 }
 
 const JobKind* job_kind_named(const std::string& name) {
-  for (const JobKind* kind : {&simulate_kind(), &design_kind(), &fit_material_kind()})
+  for (const JobKind* kind : {&simulate_kind(), &design_kind(), &fit_material_kind(), &curve_kind()})
     if (name == kind->name()) return kind;
   return nullptr;
 }

@@ -48,6 +48,50 @@ v1::SimulateReport simulate_report(const jobs::SimulateInput& input, const Infla
   return report;
 }
 
+v1::CurveReport curve_report(const jobs::SimulateInput& input, const PressureVolumeCurve& curve) {
+  v1::CurveReport report;
+  report.set_converged(curve.converged);
+  report.set_stop_reason(inflation_stop_word(curve.stop));
+  report.set_message(curve.message);
+  if (input.curve) {
+    report.set_control(input.curve->control == InflationControl::Pressure ? "pressure" : "volume_ratio");
+    report.set_range_from(input.curve->from);
+    report.set_range_to(input.curve->to);
+    report.set_points_requested(input.curve->points);
+  }
+  for (const CurvePoint& point : curve.points) {
+    v1::CurvePointReport* row = report.add_points();
+    row->set_target(point.target);
+    row->set_converged(point.converged);
+    if (point.volume_ratio) row->set_volume_ratio(*point.volume_ratio);
+    if (point.pressure_kpa) row->set_pressure_kpa(*point.pressure_kpa);
+    if (point.mean_stretch) row->set_mean_stretch(*point.mean_stretch);
+    if (point.max_stretch) row->set_max_stretch(*point.max_stretch);
+    if (point.unstable_modes) row->set_unstable_modes(*point.unstable_modes);
+    row->set_message(point.message);
+  }
+  for (const CurveExtremum& extremum : curve.extrema) {
+    v1::CurveExtremumReport* row = report.add_extrema();
+    row->set_kind(extremum.maximum ? "maximum" : "minimum");
+    row->set_point(extremum.point);
+    row->set_volume_ratio(extremum.volume_ratio);
+    row->set_pressure_kpa(extremum.pressure_kpa);
+  }
+  report.set_rest_volume_mm3(curve.rest_volume_mm3);
+  report.set_newton_iterations(curve.newton_iterations);
+  report.set_factorizations(curve.factorizations);
+  report.set_load_steps(curve.load_steps);
+  report.set_time_s(curve.time_s);
+  report.set_vertices(input.rest.vertex_count());
+  report.set_faces(input.rest.face_count());
+  report.set_material(material_spec(input.material));
+  report.set_material_name(input.material.name);
+  report.set_thickness_mm(input.thickness_mm);
+  report.set_flipped_orientation(input.flipped_orientation);
+  report.set_last_converged_point(curve.last_converged_point);
+  return report;
+}
+
 v1::DesignReport design_report(const jobs::DesignInput& input, const jobs::DesignOutcome& outcome) {
   const DesignResult& result = outcome.result;
   const PreparedTarget& target = input.target;

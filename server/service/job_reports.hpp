@@ -13,6 +13,10 @@ namespace balloon::service {
 /// The report of a finished simulation of `input`.
 balloon::v1::SimulateReport simulate_report(const jobs::SimulateInput& input, const InflationResult& result);
 
+/// The report of a finished pressure-volume curve of `input` (input.curve set); values never computed
+/// stay unset.
+balloon::v1::CurveReport curve_report(const jobs::SimulateInput& input, const PressureVolumeCurve& curve);
+
 /// The report of a finished design of `input`; design errors that were never computed stay unset.
 balloon::v1::DesignReport design_report(const jobs::DesignInput& input, const jobs::DesignOutcome& outcome);
 

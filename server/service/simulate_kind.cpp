@@ -3,14 +3,13 @@
 #include "mesh/mesh_io.hpp"
 #include "service/job_kind.hpp"
 #include "service/job_reports.hpp"
+#include "service/simulate_loading.hpp"
 #include "store/mesh_blob.hpp"
 
 namespace balloon::service {
-namespace {
 
 namespace v1 = balloon::v1;
 
-/// Decodes and checks a simulate job (mesh within `max_vertices`, material, parameters).
 ServiceStatus load_simulate(const v1::SimulateJob& job, const std::string& tenant, int max_vertices,
                             MaterialHandler& materials, std::optional<jobs::SimulateInput>* loaded) {
   TriMesh mesh;
@@ -23,6 +22,16 @@ ServiceStatus load_simulate(const v1::SimulateJob& job, const std::string& tenan
   parameters.thickness_mm = job.thickness_mm() == 0.0 ? jobs::DEFAULT_THICKNESS_MM : job.thickness_mm();
   if (job.control_case() == v1::SimulateJob::kPressureKpa) parameters.pressure_kpa = job.pressure_kpa();
   if (job.control_case() == v1::SimulateJob::kVolumeRatio) parameters.volume_ratio = job.volume_ratio();
+  if (job.control_case() == v1::SimulateJob::kCurve) {
+    jobs::CurveParameters curve;
+    const bool pressure = job.curve().range_case() == v1::CurveSweep::kPressureRange;
+    const v1::ValueRange& range = pressure ? job.curve().pressure_range() : job.curve().volume_ratio_range();
+    curve.control = pressure ? InflationControl::Pressure : InflationControl::VolumeRatio;
+    curve.from = range.from();
+    curve.to = range.to();
+    curve.points = job.curve().points();
+    parameters.curve = curve;
+  }
   // The parameters and the material are checked here first, each bad field by name (prepare_simulate
   // checks them again), so what prepare_simulate still refuses is the mesh.
   if (const std::vector<jobs::FieldProblem> problems = jobs::simulate_parameter_problems(parameters); !problems.empty())
@@ -39,6 +48,8 @@ ServiceStatus load_simulate(const v1::SimulateJob& job, const std::string& tenan
   *loaded = std::move(*input);
   return ServiceStatus::success();
 }
+
+namespace {
 
 std::string simulate_summary(const jobs::SimulateInput& input) {
   std::string summary = "simulate " + std::to_string(input.rest.vertex_count()) + " vertices, " +

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <cmath>
 #include <thread>
 #include <optional>
@@ -352,6 +353,40 @@ TEST(RemoteJobsResume, AKilledServerResumesTheDesignFromItsCheckpoint) {
   const int iterations = std::stoi(json_field(report, "iterations").value_or("0"));
   EXPECT_GT(iterations, resumed_from) << "the count must keep rising from the checkpoint";
   EXPECT_EQ(get_attempts(*server, id), 2);
+}
+
+}  // namespace
+}  // namespace balloon::testing
+
+namespace balloon::testing {
+namespace {
+
+// The curve on a remote server: `simulate --server` writes curve.csv and curve.svg, and `jobs result
+// --out-dir` gives the same bytes (proto/contract makes both from the job's CurveReport).
+TEST_F(RemoteJobs, ACurveOnTheServerWritesTheSameFilesAsJobsResult) {
+  const std::filesystem::path folder = s_scratch->path() / "curve";
+  std::filesystem::create_directories(folder);
+  const ProcessResult ran = run({"--server", server(), "simulate", s_scratch->file("bumpy.obj"), "--material",
+                                 "silicone", "--volume-ratio-range", "1.2:6", "--points", "5", "--out",
+                                 folder.string()});
+  ASSERT_EQ(ran.exit_code, 0) << ran.err << ran.out;
+  const std::string csv = read_file_bytes((folder / "curve.csv").string());
+  EXPECT_EQ(csv.rfind("volume_ratio,pressure_kpa,mean_stretch,max_stretch,unstable_modes,converged\n", 0), 0u);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 6) << csv;
+
+  const ProcessResult listed = run({"--server", server(), "jobs", "list", "--json"});
+  ASSERT_EQ(listed.exit_code, 0) << listed.err;
+  const std::size_t kind = listed.out.find("JOB_KIND_CURVE");
+  ASSERT_NE(kind, std::string::npos) << listed.out;
+  const std::string job_id = job_id_in(listed.out.substr(listed.out.rfind("\"j-", kind)));
+  ASSERT_FALSE(job_id.empty()) << listed.out;
+  const std::string out_dir = (s_scratch->path() / "curve_result").string();
+  const ProcessResult result = run({"--server", server(), "jobs", "result", job_id, "--out-dir", out_dir});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(file_names(out_dir),
+            (std::set<std::string>{"rest.obj", "inflated.obj", "report.json", "curve.csv", "curve.svg"}));
+  EXPECT_EQ(read_file_bytes(out_dir + "/curve.csv"), csv);
+  EXPECT_EQ(read_file_bytes(out_dir + "/curve.svg"), read_file_bytes((folder / "curve.svg").string()));
 }
 
 }  // namespace

@@ -401,6 +401,34 @@ TEST(HostileInputs, CatalogueGetsItsStatusesAndTheServerStaysServingAndSmall) {
     submit_case("simulate volume_ratio " + number_name(v), ratio, v == 1e308 ? StatusCode::OK : StatusCode::INVALID_ARGUMENT,
                 v == 1e308 ? "" : "volume ratio must be a positive number");
   }
+  // SimulateJob.curve (a curve job): each end of the range and the point count.
+  const auto good_curve = [] {
+    v1::SubmitJobRequest request = good_simulate();
+    v1::CurveSweep* curve = request.mutable_spec()->mutable_simulate()->mutable_curve();
+    curve->mutable_volume_ratio_range()->set_from(1.5);
+    curve->mutable_volume_ratio_range()->set_to(4.0);
+    curve->set_points(3);
+    return request;
+  };
+  submit_case("curve 1.5:4 in 3 points", good_curve(), StatusCode::OK, "");
+  for (const double v : hostile) {
+    v1::SubmitJobRequest from = good_curve();
+    from.mutable_spec()->mutable_simulate()->mutable_curve()->mutable_volume_ratio_range()->set_from(v);
+    submit_case("curve volume_ratio_range.from " + number_name(v), from, StatusCode::INVALID_ARGUMENT, "range");
+    v1::SubmitJobRequest to = good_curve();
+    to.mutable_spec()->mutable_simulate()->mutable_curve()->mutable_volume_ratio_range()->set_to(v);
+    submit_case("curve volume_ratio_range.to " + number_name(v), to, StatusCode::INVALID_ARGUMENT, "range");
+    v1::SubmitJobRequest pressure = good_curve();
+    pressure.mutable_spec()->mutable_simulate()->mutable_curve()->mutable_pressure_range()->set_from(v);
+    pressure.mutable_spec()->mutable_simulate()->mutable_curve()->mutable_pressure_range()->set_to(10.0);
+    submit_case("curve pressure_range.from " + number_name(v), pressure, StatusCode::INVALID_ARGUMENT, "range");
+  }
+  for (const int points : {0, -1, 1, 1001, std::numeric_limits<int>::max(), std::numeric_limits<int>::min()}) {
+    v1::SubmitJobRequest request = good_curve();
+    request.mutable_spec()->mutable_simulate()->mutable_curve()->set_points(points);
+    submit_case("curve points " + std::to_string(points), request, StatusCode::INVALID_ARGUMENT,
+                "points must be between 2 and 1000");
+  }
   // Every numeric field of DesignJob.
   for (const double v : hostile) {
     v1::SubmitJobRequest thickness = good_design();

@@ -2,6 +2,8 @@
 // and the HTTP files route.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -79,6 +81,51 @@ TEST(JobResultFiles, MeshesTakeTheirFormatsExtensionAndAFitHasItsPlot) {
   EXPECT_EQ(names(files), (std::vector<std::string>{"report.json", "fit.svg"}));
   EXPECT_EQ(files[1].bytes, "<svg/>");
   EXPECT_EQ(files[0].bytes.rfind("{\"fits\":[{\"model\":\"neo-hookean\",", 0), 0u) << files[0].bytes;
+}
+
+// A curve's rows: every column, an empty cell (never 0) for values never computed; report.json has them
+// as null; the plot marks the extrema.
+TEST(JobResultFiles, ACurveHasItsCsvAndPlot) {
+  v1::JobResult curve;
+  curve.set_kind(v1::JOB_KIND_CURVE);
+  v1::CurveReport* report = curve.mutable_curve_report();
+  const double ratios[3] = {1.5, 3.0, 6.0}, pressures[3] = {10.0, 12.5, 11.0};
+  for (int i = 0; i < 3; ++i) {
+    v1::CurvePointReport* point = report->add_points();
+    point->set_target(ratios[i]);
+    point->set_converged(true);
+    point->set_volume_ratio(ratios[i]);
+    point->set_pressure_kpa(pressures[i]);
+    point->set_mean_stretch(std::cbrt(ratios[i]));
+    point->set_max_stretch(1.25);
+    point->set_unstable_modes(i == 2 ? 2 : 0);
+  }
+  v1::CurvePointReport* missed = report->add_points();
+  missed->set_target(12.0);
+  missed->set_message("no equilibrium found");
+  v1::CurveExtremumReport* peak = report->add_extrema();
+  peak->set_kind("maximum");
+  peak->set_point(1);
+  peak->set_volume_ratio(3.2);
+  peak->set_pressure_kpa(12.6);
+  const std::vector<JobResultFile> files = job_result_files(curve);
+  ASSERT_EQ(names(files),
+            (std::vector<std::string>{"rest.obj", "inflated.obj", "report.json", "curve.csv", "curve.svg"}));
+  const std::string& csv = files[3].bytes;
+  EXPECT_EQ(csv.rfind("volume_ratio,pressure_kpa,mean_stretch,max_stretch,unstable_modes,converged\n1.5,10,", 0), 0u)
+      << csv;
+  EXPECT_NE(csv.find(",1.25,0,true\n3,12.5,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",1.25,2,true\n,,,,,false\n"), std::string::npos) << csv;
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5);
+  EXPECT_NE(files[2].bytes.find("\"volume_ratio\":null,\"pressure_kpa\":null,\"mean_stretch\":null,"
+                                "\"max_stretch\":null,\"unstable_modes\":null"),
+            std::string::npos)
+      << files[2].bytes;
+  const std::string& svg = files[4].bytes;
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+  EXPECT_NE(svg.find("pressure-maximum"), std::string::npos);
+  EXPECT_EQ(svg.find("pressure-minimum"), std::string::npos);
+  EXPECT_NE(svg.find("max 12.6 kPa"), std::string::npos) << svg;
 }
 
 }  // namespace

@@ -48,6 +48,7 @@ const KIND_LABELS = {
   JOB_KIND_SIMULATE: 'simulate',
   JOB_KIND_DESIGN: 'design',
   JOB_KIND_FIT_MATERIAL: 'material fit',
+  JOB_KIND_CURVE: 'curve',
 };
 
 /** "JOB_KIND_DESIGN" -> "design". */

@@ -20,6 +20,7 @@ import { SurfaceDistance } from './surface_distance.js';
 const FILES_BY_KIND = {
   JOB_KIND_DESIGN: ['rest.obj', 'inflated.obj', 'mold.stl', 'report.json', 'convergence.csv'],
   JOB_KIND_SIMULATE: ['rest.obj', 'inflated.obj', 'report.json'],
+  JOB_KIND_CURVE: ['rest.obj', 'inflated.obj', 'report.json', 'curve.csv', 'curve.svg'],
 };
 
 export class JobPanel {

@@ -1,0 +1,174 @@
+#include "solve/pressure_volume_curve.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+namespace balloon {
+namespace {
+
+double now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+std::string format_number(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.4g", value);
+  return buffer;
+}
+
+std::string describe_target(InflationControl control, double target) {
+  return control == InflationControl::Pressure ? format_number(target) + " kPa"
+                                               : "volume ratio " + format_number(target);
+}
+
+/// Vertex of the parabola through three points (abscissae distinct): where a sampled extremum lies.
+void parabola_vertex(const double x[3], const double y[3], double* vertex_x, double* vertex_y) {
+  const double a = (x[1] - x[0]) * (y[1] - y[2]), b = (x[1] - x[2]) * (y[1] - y[0]);
+  const double denominator = a - b;
+  double xv = x[1];
+  if (denominator != 0.0) xv = x[1] - 0.5 * ((x[1] - x[0]) * a - (x[1] - x[2]) * b) / denominator;
+  xv = std::clamp(xv, x[0], x[2]);
+  // Lagrange form of the same parabola at xv.
+  double yv = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    double weight = 1.0;
+    for (int j = 0; j < 3; ++j)
+      if (j != i) weight *= (xv - x[j]) / (x[i] - x[j]);
+    yv += weight * y[i];
+  }
+  *vertex_x = xv;
+  *vertex_y = yv;
+}
+
+}  // namespace
+
+std::vector<double> curve_targets(double from, double to, int points) {
+  std::vector<double> targets(static_cast<size_t>(std::max(points, 0)));
+  const double log_ratio = std::log(to / from);
+  for (int i = 0; i < points; ++i)
+    targets[static_cast<size_t>(i)] = points == 1 ? from : from * std::exp(log_ratio * i / (points - 1));
+  if (points >= 2) targets.back() = to;  // exactly the end the user asked for
+  return targets;
+}
+
+std::string curve_range_problem(InflationControl control, double from, double to, int points) {
+  if (points < MIN_CURVE_POINTS || points > MAX_CURVE_POINTS)
+    return "points must be between " + std::to_string(MIN_CURVE_POINTS) + " and " + std::to_string(MAX_CURVE_POINTS) +
+           ", got " + std::to_string(points);
+  if (!std::isfinite(from) || !std::isfinite(to)) return "the range must be two finite numbers";
+  if (control == InflationControl::VolumeRatio) {
+    if (!(from > 1.0)) return "the volume-ratio range must start above 1 (the rest volume), got " + format_number(from);
+    if (!(to <= MAX_CURVE_VOLUME_RATIO))
+      return "the volume-ratio range must end at most at " + format_number(MAX_CURVE_VOLUME_RATIO);
+  } else {
+    if (!(from > 0.0)) return "the pressure range must start above 0 kPa, got " + format_number(from);
+    if (!(to <= MAX_CURVE_PRESSURE_KPA))
+      return "the pressure range must end at most at " + format_number(MAX_CURVE_PRESSURE_KPA) + " kPa";
+  }
+  if (!(from < to)) return "the range must be A:B with A < B, got " + format_number(from) + ":" + format_number(to);
+  return "";
+}
+
+std::vector<CurveExtremum> pressure_extrema(const std::vector<CurvePoint>& points) {
+  std::vector<CurveExtremum> extrema;
+  for (size_t i = 1; i + 1 < points.size(); ++i) {
+    const CurvePoint& before = points[i - 1];
+    const CurvePoint& here = points[i];
+    const CurvePoint& after = points[i + 1];
+    if (!before.converged || !here.converged || !after.converged) continue;
+    const double p[3] = {*before.pressure_kpa, *here.pressure_kpa, *after.pressure_kpa};
+    const bool maximum = p[1] > p[0] && p[1] >= p[2];
+    const bool minimum = p[1] < p[0] && p[1] <= p[2];
+    if (!maximum && !minimum) continue;
+    CurveExtremum extremum;
+    extremum.maximum = maximum;
+    extremum.point = static_cast<int>(i);
+    const double x[3] = {std::log(*before.volume_ratio), std::log(*here.volume_ratio), std::log(*after.volume_ratio)};
+    double log_ratio = x[1], pressure = p[1];
+    if (x[0] < x[1] && x[1] < x[2]) parabola_vertex(x, p, &log_ratio, &pressure);
+    extremum.volume_ratio = std::exp(log_ratio);
+    extremum.pressure_kpa = pressure;
+    extrema.push_back(extremum);
+  }
+  return extrema;
+}
+
+PressureVolumeCurve trace_pressure_volume_curve(const TriMesh& rest, const PressureVolumeCurveOptions& options) {
+  const double start = now_s();
+  PressureVolumeCurve curve;
+  curve.last_shape = rest.vertices;
+  const std::string range_problem = curve_range_problem(options.control, options.from, options.to, options.points);
+  const std::vector<double> targets =
+      range_problem.empty() ? curve_targets(options.from, options.to, options.points) : std::vector<double>();
+  for (double target : targets) {
+    CurvePoint point;
+    point.target = target;
+    curve.points.push_back(point);
+  }
+
+  InflationOptions inflation;
+  inflation.material = options.material;
+  inflation.thickness_mm = options.thickness_mm;
+  inflation.residual_tolerance = options.residual_tolerance;
+  inflation.max_time_s = options.max_time_s;
+  inflation.cancel = options.cancel;
+  // Per-point progress below; the path's own load steps would flood the watchers with meshes.
+  InflationPath path(rest, inflation);
+
+  std::string stopped;  // set once the path has ended: why the remaining points were not reached
+  for (size_t i = 0; i < curve.points.size(); ++i) {
+    CurvePoint& point = curve.points[i];
+    if (!stopped.empty()) {
+      point.message = "not reached: " + stopped;
+      continue;
+    }
+    const InflationResult result = path.advance(options.control, point.target);
+    curve.rest_volume_mm3 = result.rest_volume_mm3;
+    curve.newton_iterations = result.newton_iterations;
+    curve.factorizations = result.factorizations;
+    curve.load_steps = result.load_steps;
+    if (!result.converged) {
+      point.message = result.message;
+      curve.stop = result.stop;
+      curve.message = "the path stopped at " + describe_target(options.control, point.target) + ": " + result.message;
+      stopped = "the path stopped at " + describe_target(options.control, point.target);
+      continue;
+    }
+    point.converged = true;
+    point.message = "converged";
+    point.volume_ratio = result.volume_ratio;
+    point.pressure_kpa = result.pressure_kpa;
+    point.mean_stretch = result.mean_stretch;
+    point.max_stretch = result.max_stretch;
+    const int modes =
+        options.control == InflationControl::Pressure ? path.pressure_unstable_modes() : result.unstable_modes;
+    if (modes >= 0) point.unstable_modes = modes;
+    curve.last_shape = result.deformed;
+    curve.last_converged_point = static_cast<int>(i);
+    if (options.progress) {
+      ProgressEvent event;
+      event.phase = "curve";
+      event.iteration = static_cast<int>(i);
+      event.elapsed_s = now_s() - start;
+      event.residual_norm = result.residual_norm;
+      event.pressure_kpa = result.pressure_kpa;
+      event.shape = &curve.last_shape;
+      options.progress(event);
+    }
+  }
+  if (!range_problem.empty()) {
+    curve.stop = InflationStop::InvalidInput;
+    curve.message = range_problem;
+  } else if (stopped.empty() && !curve.points.empty()) {
+    curve.converged = true;
+    curve.stop = InflationStop::Converged;
+    curve.message = "converged";
+  }
+  curve.extrema = pressure_extrema(curve.points);
+  curve.time_s = now_s() - start;
+  return curve;
+}
+
+}  // namespace balloon

@@ -1,0 +1,159 @@
+// The pressure-volume curve against the thin sphere's closed form p = h Psi'(l) / (R l^2): every point of
+// one continuation path, the Neo-Hookean pressure maximum at l = 7^(1/6), and hostile ranges.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "material/homogeneous_tests.hpp"
+#include "mesh/icosphere.hpp"
+#include "mesh/mesh_geometry.hpp"
+#include "solve/pressure_volume_curve.hpp"
+
+namespace balloon {
+namespace {
+
+Material make(MaterialModel model, double a, double b = 0, double c = 0) {
+  Material m;
+  m.model = model;
+  m.params = {a, b, c};
+  return m;
+}
+
+/// The polyhedron's own radius: the sphere with its volume-to-area ratio.
+double effective_radius(const TriMesh& sphere) {
+  return 3.0 * enclosed_volume(sphere.vertices, sphere.faces) / surface_area(sphere.vertices, sphere.faces);
+}
+
+PressureVolumeCurveOptions volume_curve(const Material& material, double from, double to, int points) {
+  PressureVolumeCurveOptions options;
+  options.material = material;
+  options.thickness_mm = 0.5;
+  options.control = InflationControl::VolumeRatio;
+  options.from = from;
+  options.to = to;
+  options.points = points;
+  return options;
+}
+
+TEST(PressureVolumeCurve, TargetsAreGeometric) {
+  const std::vector<double> targets = curve_targets(1.01, 250.0, 5);
+  ASSERT_EQ(targets.size(), 5u);
+  EXPECT_DOUBLE_EQ(targets.front(), 1.01);
+  EXPECT_DOUBLE_EQ(targets.back(), 250.0);
+  const double ratio = std::pow(250.0 / 1.01, 0.25);
+  for (size_t i = 1; i < targets.size(); ++i) EXPECT_NEAR(targets[i] / targets[i - 1], ratio, 1e-12 * ratio);
+}
+
+struct CurveCase {
+  const char* label;
+  Material material;
+  double to;
+};
+
+class CurveSphereLawTest : public ::testing::TestWithParam<CurveCase> {};
+
+// Along the whole path, past the pressure maximum, every point within 0.5% of the closed form.
+TEST_P(CurveSphereLawTest, EveryPointMatchesTheClosedFormWithinHalfPercent) {
+  const CurveCase c = GetParam();
+  const TriMesh sphere = make_icosphere(10.0, 3);  // 642 vertices
+  const double radius = effective_radius(sphere);
+  const PressureVolumeCurve curve = trace_pressure_volume_curve(sphere, volume_curve(c.material, 1.05, c.to, 12));
+  ASSERT_TRUE(curve.converged) << c.label << ": " << curve.message;
+  ASSERT_EQ(curve.points.size(), 12u);
+  for (const CurvePoint& point : curve.points) {
+    ASSERT_TRUE(point.converged) << point.message;
+    ASSERT_TRUE(point.volume_ratio && point.pressure_kpa && point.mean_stretch && point.max_stretch);
+    EXPECT_NEAR(*point.volume_ratio, point.target, 1e-6 * point.target);
+    const double stretch = std::cbrt(*point.volume_ratio);
+    const double expected = 1e3 * sphere_pressure(c.material, radius, 0.5, stretch);
+    EXPECT_NEAR(*point.pressure_kpa, expected, 5e-3 * std::abs(expected)) << c.label << " at stretch " << stretch;
+    EXPECT_NEAR(*point.mean_stretch, stretch, 2e-3 * stretch);
+    EXPECT_GE(*point.max_stretch, *point.mean_stretch * (1 - 1e-9));
+    EXPECT_TRUE(point.unstable_modes.has_value());
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Laws, CurveSphereLawTest,
+    ::testing::Values(CurveCase{"neo_hookean", make(MaterialModel::NeoHookean, 0.3), 27.0},
+                      CurveCase{"hart_smith", make(MaterialModel::HartSmith, 0.1, 3e-4, 1.0), 125.0}),
+    [](const auto& test_info) { return std::string(test_info.param.label); });
+
+// The Neo-Hookean sphere's only pressure extremum is the maximum at l = 7^(1/6) = 1.383 (V/V0 = sqrt 7):
+// 16 points over 1.01..8 are 3.8% apart in stretch; the parabola puts the maximum within 1% of it.
+TEST(PressureVolumeCurve, FindsTheNeoHookeanPressureMaximum) {
+  const TriMesh sphere = make_icosphere(10.0, 2);  // 162 vertices
+  const Material nh = make(MaterialModel::NeoHookean, 0.3);
+  const PressureVolumeCurve curve = trace_pressure_volume_curve(sphere, volume_curve(nh, 1.01, 8.0, 16));
+  ASSERT_TRUE(curve.converged) << curve.message;
+  ASSERT_EQ(curve.extrema.size(), 1u);
+  const CurveExtremum& peak = curve.extrema.front();
+  EXPECT_TRUE(peak.maximum);
+  const double expected_stretch = std::pow(7.0, 1.0 / 6.0);
+  EXPECT_NEAR(std::cbrt(peak.volume_ratio), expected_stretch, 1e-2 * expected_stretch);
+  const double expected_pressure = 1e3 * sphere_pressure(nh, effective_radius(sphere), 0.5, expected_stretch);
+  EXPECT_NEAR(peak.pressure_kpa, expected_pressure, 1e-2 * expected_pressure);
+  // The sampled point is the largest pressure of the curve, and both sides fall away from it.
+  for (const CurvePoint& point : curve.points) EXPECT_LE(*point.pressure_kpa, *curve.points[peak.point].pressure_kpa);
+}
+
+// Pressure control climbs the ascending branch, where the stiffness is positive definite, and ends with
+// a stated reason at the first pressure above the maximum; the points after it have no values.
+TEST(PressureVolumeCurve, PressureControlStopsAtThePressureMaximum) {
+  const TriMesh sphere = make_icosphere(10.0, 2);
+  const Material nh = make(MaterialModel::NeoHookean, 0.3);
+  const double radius = effective_radius(sphere);
+  const double peak = 1e3 * sphere_pressure(nh, radius, 0.5, std::pow(7.0, 1.0 / 6.0));
+  PressureVolumeCurveOptions options = volume_curve(nh, 0.2 * peak, 2.0 * peak, 8);
+  options.control = InflationControl::Pressure;
+  const PressureVolumeCurve curve = trace_pressure_volume_curve(sphere, options);
+  EXPECT_FALSE(curve.converged);
+  EXPECT_EQ(curve.stop, InflationStop::AboveMaximumPressure) << curve.message;
+  ASSERT_EQ(curve.points.size(), 8u);
+  int converged = 0;
+  for (const CurvePoint& point : curve.points) {
+    if (point.converged) {
+      ++converged;
+      EXPECT_NEAR(*point.pressure_kpa, point.target, 1e-9 * point.target);
+      const double expected = 1e3 * sphere_pressure(nh, radius, 0.5, std::cbrt(*point.volume_ratio));
+      EXPECT_NEAR(*point.pressure_kpa, expected, 5e-3 * expected);
+      EXPECT_EQ(point.unstable_modes, 0);
+    } else {
+      EXPECT_GT(point.target, 0.99 * peak);
+      EXPECT_FALSE(point.pressure_kpa || point.volume_ratio || point.mean_stretch || point.max_stretch ||
+                   point.unstable_modes);
+      EXPECT_FALSE(point.message.empty());
+    }
+  }
+  // 0.2 peak * 10^(k/7) stays below the peak for k <= 4.
+  EXPECT_EQ(converged, 5);
+  EXPECT_NE(curve.message.find("maximum pressure"), std::string::npos) << curve.message;
+}
+
+TEST(PressureVolumeCurve, BadRangesAreReportedNotThrown) {
+  const TriMesh sphere = make_icosphere(10.0, 1);
+  const Material nh = make(MaterialModel::NeoHookean, 0.3);
+  struct Bad {
+    double from, to;
+    int points;
+    const char* word;
+  };
+  for (const Bad& bad : {Bad{1.0, 4.0, 5, "above 1"}, Bad{4.0, 2.0, 5, "A < B"}, Bad{1.5, std::nan(""), 5, "finite"},
+                         Bad{1.5, 4.0, 1, "points"}, Bad{1.5, 4.0, 1001, "points"}, Bad{1.5, 1e9, 5, "at most"}}) {
+    const PressureVolumeCurve curve = trace_pressure_volume_curve(sphere, volume_curve(nh, bad.from, bad.to, bad.points));
+    EXPECT_FALSE(curve.converged);
+    EXPECT_EQ(curve.stop, InflationStop::InvalidInput);
+    EXPECT_TRUE(curve.points.empty());
+    EXPECT_NE(curve.message.find(bad.word), std::string::npos) << curve.message;
+  }
+  PressureVolumeCurveOptions thin = volume_curve(nh, 1.5, 4.0, 3);
+  thin.thickness_mm = -1.0;
+  const PressureVolumeCurve curve = trace_pressure_volume_curve(sphere, thin);
+  EXPECT_EQ(curve.stop, InflationStop::InvalidInput);
+  EXPECT_NE(curve.message.find("thickness"), std::string::npos) << curve.message;
+  ASSERT_EQ(curve.points.size(), 3u);
+  for (const CurvePoint& point : curve.points) EXPECT_FALSE(point.converged || point.pressure_kpa);
+}
+
+}  // namespace
+}  // namespace balloon
