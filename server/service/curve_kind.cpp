@@ -29,12 +29,7 @@ class CurveKind final : public JobKind {
 
   ServiceStatus check(const v1::JobSpec& spec, const CheckContext& context, CheckedJob* checked) const override {
     std::optional<jobs::SimulateInput> input;
-    ServiceStatus status =
-        load_simulate(spec.simulate(), context.caller.tenant, context.max_mesh_vertices, context.materials, &input);
-    if (!status.ok()) return std::move(status).under("simulate.");
-    checked->stored_spec = spec;
-    if (names_stored_material(spec.simulate().material()))
-      checked->stored_spec.mutable_simulate()->mutable_material()->set_spec(material_spec(input->material));
+    if (ServiceStatus status = check_simulate_spec(spec, context, checked, &input); !status.ok()) return status;
     checked->summary = curve_summary(*input);
     return ServiceStatus::success();
   }

@@ -49,6 +49,17 @@ ServiceStatus load_simulate(const v1::SimulateJob& job, const std::string& tenan
   return ServiceStatus::success();
 }
 
+ServiceStatus check_simulate_spec(const v1::JobSpec& spec, const CheckContext& context, CheckedJob* checked,
+                                  std::optional<jobs::SimulateInput>* input) {
+  ServiceStatus status =
+      load_simulate(spec.simulate(), context.caller.tenant, context.max_mesh_vertices, context.materials, input);
+  if (!status.ok()) return std::move(status).under("simulate.");
+  checked->stored_spec = spec;
+  if (names_stored_material(spec.simulate().material()))
+    checked->stored_spec.mutable_simulate()->mutable_material()->set_spec(material_spec((*input)->material));
+  return ServiceStatus::success();
+}
+
 namespace {
 
 std::string simulate_summary(const jobs::SimulateInput& input) {
@@ -69,12 +80,7 @@ class SimulateKind final : public JobKind {
 
   ServiceStatus check(const v1::JobSpec& spec, const CheckContext& context, CheckedJob* checked) const override {
     std::optional<jobs::SimulateInput> input;
-    ServiceStatus status =
-        load_simulate(spec.simulate(), context.caller.tenant, context.max_mesh_vertices, context.materials, &input);
-    if (!status.ok()) return std::move(status).under("simulate.");
-    checked->stored_spec = spec;
-    if (names_stored_material(spec.simulate().material()))
-      checked->stored_spec.mutable_simulate()->mutable_material()->set_spec(material_spec(input->material));
+    if (ServiceStatus status = check_simulate_spec(spec, context, checked, &input); !status.ok()) return status;
     checked->summary = simulate_summary(*input);
     checked->prepared = std::make_shared<const jobs::SimulateInput>(std::move(*input));
     return ServiceStatus::success();
