@@ -12,6 +12,8 @@ PACKAGES=(
   clang libclang-rt-14-dev
   # numerics: Eigen, CHOLMOD (SuiteSparse) with OpenBLAS behind it, nanoflann (kd-tree), CGAL (remeshing, AABB)
   libeigen3-dev libsuitesparse-dev libopenblas0-pthread libnanoflann-dev libcgal-dev
+  # MUMPS (sequential): the multifrontal LDL^T of indefinite stiffness matrices (past pressure maxima)
+  libmumps-seq-dev
   # mesh files (nlohmann-json: the glTF layout check before assimp reads an upload)
   libassimp-dev nlohmann-json3-dev
   # service: gRPC, protobuf, SQLite, HTTP gateway

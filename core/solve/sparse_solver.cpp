@@ -1,5 +1,6 @@
 #include "solve/sparse_solver.hpp"
 
+#include "solve/indefinite_factorization.hpp"
 #include "solve/linear_algebra_threads.hpp"
 
 #include <cholmod.h>
@@ -14,8 +15,9 @@ struct SparseSolver::Internals {
   cholmod_common common{};
   cholmod_sparse* matrix = nullptr;
   cholmod_factor* llt = nullptr;   // supernodal symbolic + numeric
-  cholmod_factor* ldlt = nullptr;  // simplicial symbolic + numeric
-  cholmod_factor* last = nullptr;  // the factor solve() uses
+  cholmod_factor* last = nullptr;  // the CHOLMOD factor solve() uses, when the last factorization was LL^T
+  std::unique_ptr<IndefiniteFactorization> ldlt;  // symmetric indefinite matrices; made at first use
+  bool ldlt_is_last = false;       // solve() uses `ldlt`
   int n = 0;
   int negative = 0;
 
@@ -26,7 +28,6 @@ struct SparseSolver::Internals {
   }
   ~Internals() {
     if (llt) cholmod_free_factor(&llt, &common);
-    if (ldlt) cholmod_free_factor(&ldlt, &common);
     if (matrix) cholmod_free_sparse(&matrix, &common);
     cholmod_finish(&common);
   }
@@ -44,9 +45,10 @@ SparseSolver::~SparseSolver() = default;
 
 void SparseSolver::set_pattern(int n, const std::vector<int>& column_starts, const std::vector<int>& row_indices) {
   if (m->llt) cholmod_free_factor(&m->llt, &m->common);
-  if (m->ldlt) cholmod_free_factor(&m->ldlt, &m->common);
   if (m->matrix) cholmod_free_sparse(&m->matrix, &m->common);
   m->last = nullptr;
+  m->ldlt_is_last = false;
+  m->ldlt.reset();
   m->n = n;
   m->matrix = cholmod_allocate_sparse(static_cast<size_t>(n), static_cast<size_t>(n), row_indices.size(), 1, 1, 1,
                                       CHOLMOD_REAL, &m->common);
@@ -68,6 +70,7 @@ SparseSolver::Status SparseSolver::factorize_llt(const std::vector<double>& valu
   m->common.quick_return_if_not_posdef = 1;
   double beta[2] = {shift, 0.0};
   ++m_factorizations;
+  m->ldlt_is_last = false;
   const int ok = cholmod_factorize_p(m->matrix, beta, nullptr, 0, m->llt, &m->common);
   m->negative = 0;
   if (!ok) return Status::Failed;
@@ -80,43 +83,35 @@ SparseSolver::Status SparseSolver::factorize_llt(const std::vector<double>& valu
 }
 
 SparseSolver::Status SparseSolver::factorize_ldlt(const std::vector<double>& values, double shift) {
-  m->copy_values(values);
-  if (!m->ldlt) {
-    m->common.supernodal = CHOLMOD_SIMPLICIAL;
-    m->common.final_ll = 0;
-    m->ldlt = cholmod_analyze(m->matrix, &m->common);
-    if (!m->ldlt) return Status::Failed;
-  }
-  m->common.supernodal = CHOLMOD_SIMPLICIAL;
-  m->common.final_ll = 0;
-  double beta[2] = {shift, 0.0};
-  ++m_factorizations;
-  const int ok = cholmod_factorize_p(m->matrix, beta, nullptr, 0, m->ldlt, &m->common);
-  if (!ok) return Status::Failed;
-  // Simplicial LDL^T keeps D as the first entry of each column.
-  const auto* p = static_cast<const int*>(m->ldlt->p);
-  const auto* x = static_cast<const double*>(m->ldlt->x);
+  m->copy_values(values);  // checks the values are finite
+  m->last = nullptr;
+  m->ldlt_is_last = false;
   m->negative = 0;
-  bool singular = m->ldlt->minor < m->ldlt->n;
-  for (int j = 0; j < m->n && !singular; ++j) {
-    const double d = x[p[j]];
-    if (!std::isfinite(d) || d == 0.0) singular = true;
-    if (d < 0.0) ++m->negative;
+  if (!m->ldlt) {
+    const auto* starts = static_cast<const int*>(m->matrix->p);
+    const auto* rows = static_cast<const int*>(m->matrix->i);
+    m->ldlt = std::make_unique<IndefiniteFactorization>();
+    m->ldlt->set_pattern(m->n, std::vector<int>(starts, starts + m->n + 1),
+                         std::vector<int>(rows, rows + m->matrix->nzmax));
   }
-  if (singular) {
-    m->last = nullptr;
-    return Status::Singular;
+  ++m_factorizations;
+  switch (m->ldlt->factorize(values, shift)) {
+    case IndefiniteFactorization::Status::Ok: break;
+    case IndefiniteFactorization::Status::Singular: return Status::Singular;
+    case IndefiniteFactorization::Status::Failed: return Status::Failed;
   }
-  m->last = m->ldlt;
+  m->negative = m->ldlt->negative_pivots();
+  m->ldlt_is_last = true;
   return Status::Ok;
 }
 
 int SparseSolver::negative_pivots() const { return m->negative; }
 
 Eigen::VectorXd SparseSolver::solve(const Eigen::VectorXd& rhs) const {
-  if (!m->last) throw std::logic_error("SparseSolver::solve without a successful factorization");
+  if (!m->last && !m->ldlt_is_last) throw std::logic_error("SparseSolver::solve without a successful factorization");
   if (rhs.size() != m->n) throw std::invalid_argument("SparseSolver::solve: size mismatch");
   if (!rhs.allFinite()) throw std::invalid_argument("SparseSolver::solve: non-finite right-hand side");
+  if (m->ldlt_is_last) return m->ldlt->solve(rhs);
   cholmod_dense b{};
   b.nrow = static_cast<size_t>(m->n);
   b.ncol = 1;

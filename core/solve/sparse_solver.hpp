@@ -1,5 +1,6 @@
 #pragma once
-/// Sparse symmetric solver for the Newton systems, with CHOLMOD hidden behind this interface.
+/// Sparse symmetric solver for the Newton systems, with CHOLMOD (positive definite) and MUMPS (indefinite,
+/// solve/indefinite_factorization) hidden behind this interface.
 /// Analyse the pattern once, then factorize new values as often as needed: the symbolic analysis
 /// (ordering, supernodes) is reused.
 #include <Eigen/Core>
@@ -23,7 +24,7 @@ class SparseSolver {
 
   /// Supernodal LL^T of A + shift I. NotPositiveDefinite when it does not exist.
   Status factorize_llt(const std::vector<double>& values, double shift = 0.0);
-  /// Simplicial LDL^T of A + shift I, for symmetric indefinite matrices; see negative_pivots().
+  /// Multifrontal LDL^T (MUMPS) of A + shift I, for symmetric indefinite matrices; see negative_pivots().
   Status factorize_ldlt(const std::vector<double>& values, double shift = 0.0);
   /// Number of negative entries of D after factorize_ldlt (the inertia of A); 0 after an LL^T.
   int negative_pivots() const;
