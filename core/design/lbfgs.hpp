@@ -27,10 +27,10 @@ class Lbfgs {
   /// Forgets every pair (a stale curvature model).
   void clear() { m_pairs.clear(); }
   bool empty() const { return m_pairs.empty(); }
-
- private:
+  /// The initial inverse Hessian (the preconditioner) alone times `q`; `q` itself without one.
   Eigen::VectorXd precondition(const Eigen::VectorXd& q) const;
 
+ private:
   struct Preconditioner;
   int m_memory;
   std::deque<std::pair<Eigen::VectorXd, Eigen::VectorXd>> m_pairs;  ///< (s, y)

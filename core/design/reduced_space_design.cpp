@@ -12,6 +12,7 @@
 #include "design/design_objective.hpp"
 #include "design/distance_energy.hpp"
 #include "design/lbfgs.hpp"
+#include "design/reduced_gauss_newton.hpp"
 #include "design/surface_distance.hpp"
 #include "solve/equilibrium_solver.hpp"
 
@@ -31,6 +32,10 @@ constexpr double STALL_OBJECTIVE_DECREASE = 0.1;
 constexpr double MATCH_TOLERANCE_REL = 1e-4;
 /// First-order optimality: the design gradient below this fraction of its value at the start.
 constexpr double OPTIMALITY_TOLERANCE = 1e-6;
+/// Conjugate-gradient iterations (two solves each, no factorization) and relative residual of one
+/// Gauss-Newton direction.
+constexpr int GAUSS_NEWTON_CG_ITERATIONS = 20;
+constexpr double GAUSS_NEWTON_CG_TOLERANCE = 1e-2;
 
 /// A fraction as a short human string: 0.01 -> "1%", 1e-4 -> "1e-04".
 std::string format_fraction(double fraction) {
@@ -112,12 +117,18 @@ class ReducedSpaceDesign {
         stop_with(result, DesignStop::TimeLimit, "time limit reached");
         break;
       }
-      Eigen::VectorXd direction = -m_lbfgs.apply(gradient);
-      for (int c = 0; c < direction.size(); ++c)
-        if (!m_rest_free[static_cast<size_t>(c)]) direction[c] = 0.0;
-      if (!(direction.dot(gradient) < 0.0)) {
-        m_lbfgs.clear();
-        direction = -gradient;
+      // Gauss-Newton in the reduced space first; L-BFGS where it gives no descent direction.
+      const GaussNewtonDirection gauss_newton = gauss_newton_direction(rest, gradient);
+      const bool newton_like = gauss_newton.descent;
+      Eigen::VectorXd direction = gauss_newton.direction;
+      if (!newton_like) {
+        direction = -m_lbfgs.apply(gradient);
+        for (int c = 0; c < direction.size(); ++c)
+          if (!m_rest_free[static_cast<size_t>(c)]) direction[c] = 0.0;
+        if (!(direction.dot(gradient) < 0.0)) {
+          m_lbfgs.clear();
+          direction = -gradient;
+        }
       }
       // Trust region on the rest shape: no vertex moves more than `radius` (at most 2% of the target's
       // size) per step. The radius shrinks to the last step that needed halving and grows back after
@@ -125,7 +136,7 @@ class ReducedSpaceDesign {
       const double largest = unflatten(direction).rowwise().norm().maxCoeff();
       double t = largest > radius ? radius / largest : 1.0;
       const double first_t = t;
-      if (m_lbfgs.empty()) t = std::min(t, 0.002 * result.bbox_diag_mm / std::max(largest, 1e-300));
+      if (!newton_like && m_lbfgs.empty()) t = std::min(t, 0.002 * result.bbox_diag_mm / std::max(largest, 1e-300));
       const double slope = direction.dot(gradient);
       // First-order response of the equilibrium to the rest step, from the factorization the gradient
       // just used: each trial starts Newton a second-order distance from its solution.
@@ -181,9 +192,14 @@ class ReducedSpaceDesign {
       m_x = trial_x;
       m_pressure = trial_pressure;
       const bool collisions_changed = m_objective.update_collisions(rest, result);
+      // Re-placed on the target after every step: the six pinned coordinates otherwise keep the start's
+      // placement, and E_surf (not rigid-invariant) then fights E_dist (rigid-invariant) for it, a
+      // false minimum where a matchable target stalled at 4e-4 of its size (rounding decided which run).
+      const bool realigned = m_objective.realign(m_x);
       Eigen::VectorXd new_gradient;
-      // The line search already evaluated this point; only a changed set of colliding pairs alters it.
-      objective = collisions_changed ? m_objective.value(rest, m_x) : trial_objective;
+      // The line search already evaluated this point; only a changed set of colliding pairs or a
+      // re-placement alters it.
+      objective = collisions_changed || realigned ? m_objective.value(rest, m_x) : trial_objective;
       if (!objective_gradient(rest, new_gradient)) {
         stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized");
         break;
@@ -260,6 +276,20 @@ class ReducedSpaceDesign {
       if (!m_rest_free[static_cast<size_t>(c)]) w[c] = 0.0;
     gradient -= (gradient.dot(w) / w.squaredNorm()) * w;
     return gradient.allFinite();
+  }
+
+  /// The Gauss-Newton direction at the current equilibrium (the sensitivity was prepared by the last
+  /// objective_gradient): E_dist's and E_surf's Gauss-Newton Hessian in inflated coordinates, pulled back.
+  GaussNewtonDirection gauss_newton_direction(const Eigen::VectorXd& rest, const Eigen::VectorXd& gradient) {
+    std::vector<Eigen::Triplet<double>> entries;
+    m_distance.hessian_triplets(m_x, entries, DistanceHessian::GaussNewton);
+    m_objective.add_surface_hessian(m_x, entries, 0);
+    Eigen::SparseMatrix<double> hessian(m_x.size(), m_x.size());
+    hessian.setFromTriplets(entries.begin(), entries.end());
+    return reduced_gauss_newton_direction(
+        m_sensitivity, hessian, gradient, m_rest_free, m_model.volume_gradient(rest),
+        [this](const Eigen::VectorXd& q) { return m_lbfgs.precondition(q); }, GAUSS_NEWTON_CG_ITERATIONS,
+        GAUSS_NEWTON_CG_TOLERANCE);
   }
 
   /// L-BFGS's initial inverse Hessian: the Gauss-Newton Hessian of E_dist at the start's inflation,

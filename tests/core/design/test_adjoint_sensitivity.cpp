@@ -2,96 +2,13 @@
 
 #include <gtest/gtest.h>
 
-#include <random>
-#include <vector>
-
-#include "material/material.hpp"
-#include "mesh/icosphere.hpp"
-#include "mesh/mesh_geometry.hpp"
-#include "solve/equilibrium_solver.hpp"
-#include "solve/inflation.hpp"
-#include "solve/rigid_modes.hpp"
+#include "sensitivity_scene.hpp"
 
 namespace balloon {
 namespace {
 
-Eigen::VectorXd flat(const Positions& p) {
-  Eigen::VectorXd out(3 * p.rows());
-  for (Eigen::Index v = 0; v < p.rows(); ++v) out.segment<3>(3 * v) = p.row(v).transpose();
-  return out;
-}
-
-Positions unflat(const Eigen::VectorXd& x) {
-  Positions out(x.size() / 3, 3);
-  for (Eigen::Index v = 0; v < out.rows(); ++v) out.row(v) = x.segment<3>(3 * v).transpose();
-  return out;
-}
-
-/// An asymmetric balloon (42-vertex ellipsoid, semi-axes 14, 10, 8 mm) inflated 3-fold under volume
-/// control, with the model and solver the design uses, for finite differences of x(rest).
-struct Scene {
-  TriMesh rest;
-  Material material = *parse_material_spec("silicone");
-  fem::BalloonModel model;
-  std::vector<bool> fixed;
-  EquilibriumSolver solver;
-  Eigen::VectorXd x;
-  double pressure_mpa = 0.0;
-  double target_volume = 0.0;
-  NewtonSettings tight;
-
-  static TriMesh ellipsoid() {
-    TriMesh mesh = make_icosphere(10.0, 1);
-    mesh.vertices.col(0) *= 1.4;
-    mesh.vertices.col(2) *= 0.8;
-    return mesh;
-  }
-  static std::vector<bool> support(const TriMesh& mesh) {
-    std::vector<bool> fixed(static_cast<size_t>(3 * mesh.vertex_count()), false);
-    for (int c : rigid_support_coordinates(mesh.vertices)) fixed[static_cast<size_t>(c)] = true;
-    return fixed;
-  }
-
-  Scene()
-      : rest(ellipsoid()),
-        model(rest, material, std::vector<double>(static_cast<size_t>(rest.face_count()), 0.5)),
-        fixed(support(rest)),
-        solver(model, fixed) {
-    InflationOptions inflation;
-    inflation.material = material;
-    inflation.volume_ratio = 3.0;
-    const InflationResult inflated = inflate(rest, inflation);
-    EXPECT_TRUE(inflated.converged) << inflated.message;
-    x = flat(inflated.deformed);
-    pressure_mpa = 1e-3 * inflated.pressure_kpa;
-    target_volume = enclosed_volume(inflated.deformed, rest.faces);
-    tight.relative_tolerance = 1e-12;
-    tight.max_iterations = 50;
-    // inflate() used its own support: settle on this solver's pinned coordinates.
-    const NewtonReport report = solver.solve_volume(x, pressure_mpa, target_volume, tight);
-    EXPECT_TRUE(report.converged) << report.message;
-  }
-
-  /// The equilibrium of rest shape `rest_x` (flat), from the base equilibrium.
-  Eigen::VectorXd equilibrium(const Eigen::VectorXd& rest_x, double* pressure = nullptr) {
-    model.set_rest_positions(unflat(rest_x));
-    Eigen::VectorXd solved = x;
-    double p = pressure_mpa;
-    const NewtonReport report = solver.solve_volume(solved, p, target_volume, tight);
-    EXPECT_TRUE(report.converged) << report.message;
-    if (pressure) *pressure = p;
-    return solved;
-  }
-
-  /// A smooth random direction over the free rest coordinates (mm per unit step).
-  Eigen::VectorXd direction(unsigned seed) const {
-    std::mt19937 random(seed);
-    std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-    Eigen::VectorXd d(3 * rest.vertex_count());
-    for (Eigen::Index c = 0; c < d.size(); ++c) d[c] = fixed[static_cast<size_t>(c)] ? 0.0 : uniform(random);
-    return d;
-  }
-};
+using design_test::flat;
+using design_test::Scene;
 
 TEST(AdjointSensitivity, DesignGradientMatchesCentralDifferences) {
   Scene scene;

@@ -1,0 +1,54 @@
+#include "design/reduced_gauss_newton.hpp"
+
+#include <gtest/gtest.h>
+
+#include "sensitivity_scene.hpp"
+
+namespace balloon {
+namespace {
+
+using design_test::flat;
+using design_test::Scene;
+
+/// The direction solves the Gauss-Newton system of the reduced objective J(x(rest)) = 1/2 |x - goal|^2,
+/// A d = -g with A = P J^T J P: checked along random directions e against the sensitivity J taken by
+/// central differences of equilibria, e^T A d = (J e)_fd . (J d)_fd = -e^T g.
+TEST(ReducedGaussNewton, DirectionSolvesTheGaussNewtonSystemOfFiniteDifferenceSensitivities) {
+  Scene scene;
+  const Eigen::VectorXd rest = flat(scene.rest.vertices);
+  const Eigen::VectorXd goal = scene.x + 0.5 * scene.direction(11);
+  scene.model.set_rest_positions(scene.rest.vertices);
+  AdjointSensitivity sensitivity(scene.model, scene.solver);
+  ASSERT_TRUE(sensitivity.prepare(rest, scene.x, scene.pressure_mpa));
+
+  const std::vector<bool> rest_free(static_cast<size_t>(rest.size()), true);
+  const Eigen::VectorXd w = scene.model.volume_gradient(rest);
+  const auto project = [&](Eigen::VectorXd d) { return Eigen::VectorXd(d - (d.dot(w) / w.squaredNorm()) * w); };
+  const Eigen::VectorXd gradient = project(sensitivity.gradient(scene.x - goal));
+  ASSERT_GT(gradient.norm(), 1e-6) << "a zero gradient would pass any comparison";
+
+  Eigen::SparseMatrix<double> identity(rest.size(), rest.size());
+  identity.setIdentity();
+  const GaussNewtonDirection step = reduced_gauss_newton_direction(
+      sensitivity, identity, gradient, rest_free, w, [](const Eigen::VectorXd& q) { return q; }, 500, 1e-12);
+  ASSERT_TRUE(step.descent);
+  ASSERT_GT(step.direction.norm(), 1e-6);
+  EXPECT_LT(std::abs(step.direction.dot(w)), 1e-9 * step.direction.norm() * w.norm()) << "the rest volume is held";
+
+  constexpr double STEP_MM = 1e-4;
+  const auto sensitivity_fd = [&](const Eigen::VectorXd& d) {
+    return Eigen::VectorXd((scene.equilibrium(rest + STEP_MM * d) - scene.equilibrium(rest - STEP_MM * d)) /
+                           (2.0 * STEP_MM));
+  };
+  const Eigen::VectorXd response = sensitivity_fd(step.direction);
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const Eigen::VectorXd e = project(scene.direction(seed));
+    const double model = sensitivity_fd(e).dot(response);
+    EXPECT_NEAR(model, -e.dot(gradient), 1e-4 * std::abs(e.dot(gradient)) + 1e-9)
+        << "direction " << seed << ": e^T A d " << model << ", -e^T g " << -e.dot(gradient);
+  }
+  std::printf("Gauss-Newton direction: %d CG iterations\n", step.cg_iterations);
+}
+
+}  // namespace
+}  // namespace balloon
