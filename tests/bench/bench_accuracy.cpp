@@ -4,9 +4,10 @@
 //    against the closed form of a thin sphere at the stretch of the reached volume, for the 50 mm sphere
 //    the mesh approximates and for the polyhedron's own radius 3V/A (the ctest's convention);
 //  - one organic corpus shape (spot by default) at a 150 mm bounding-box diagonal, remeshed to 500 to
-//    16,000 vertices: the mean distance of its inflated vertices to the inflated 40,000-vertex remesh (after
-//    a rigid point-to-surface alignment), in mm and in % of that reference's diagonal; beside it the same
-//    distance for the rest meshes (what the remeshing alone costs).
+//    16,000 vertices: the mean distance of its inflated surface to the inflated 40,000-vertex remesh (after
+//    a rigid point-to-surface alignment; two-sided: each surface's vertices to the other, averaged), in mm
+//    and in % of that reference's diagonal; beside it the same distance for the rest meshes (what the
+//    remeshing alone costs).
 //  Per row: vertices, the solver's time_s, Newton iterations, factorizations, the error, peak memory (MB)
 //  and MB per 1,000 vertices.
 // Design part: three corpus shapes (spot, bunny, blob; 150 mm diagonal), adjoint method, each remeshed to
@@ -221,6 +222,13 @@ PlotPanel sphere_part(const Settings& settings, const balloon::Material& materia
   return panel;
 }
 
+/// Mean distance between two surfaces (mm): the average of the mean distance of a's vertices to b and of
+/// b's vertices to a. Both directions, so that the chords between one mesh's vertices count too.
+double two_sided_mean_mm(const balloon::TriMesh& a, const balloon::SurfaceDistance& b_surface,
+                         const balloon::TriMesh& b) {
+  return 0.5 * (b_surface.stats(a.vertices).avg_mm + balloon::SurfaceDistance(a).stats(b.vertices).avg_mm);
+}
+
 PlotPanel organic_part(const Settings& settings, const balloon::Material& material, const Shape& shape) {
   const std::vector<int> resolutions = settings.quick ? std::vector<int>{500, 1000}
                                                       : std::vector<int>{500, 1000, 2000, 4000, 8000, 16000};
@@ -237,56 +245,76 @@ PlotPanel organic_part(const Settings& settings, const balloon::Material& materi
     std::printf("cannot load %s: %s\n", shape.file.c_str(), input.error().c_str());
     return panel;
   }
-  auto reference = prepare(*input, reference_resolution);
-  if (!reference) {
-    std::printf("cannot prepare the reference: %s\n", reference.error().c_str());
-    return panel;
-  }
-  const Solve reference_solve = solve(reference->mesh, material);
-  std::optional<balloon::SurfaceDistance> inflated_reference;
-  if (reference_solve.result.converged)
-    inflated_reference.emplace(balloon::TriMesh{reference_solve.result.deformed, reference->mesh.faces});
-  const balloon::SurfaceDistance rest_reference(reference->mesh);
-  const double diag = inflated_reference ? inflated_reference->bbox_diagonal_mm() : NOT_COMPUTED;
-  std::printf("reference inflated: %s, diagonal %s mm (rest %.1f mm)\n", status(reference_solve.result).c_str(),
-              cell(diag, "%.1f").c_str(), reference->bbox_diag_mm);
-  std::printf("%8s %9s %7s %8s %10s %10s %12s %9s %10s  %s\n", "vertices", "time_s", "newton", "factors", "err_mm",
-              "err_%diag", "rest_err_mm", "peak_MB", "MB/1k_vert", "status");
-  std::ofstream csv(settings.out_dir + "/forward_organic.csv");
-  csv << "shape,vertices,time_s,newton_iterations,factorizations,mean_distance_mm,mean_distance_pct_diagonal,"
-         "rest_mean_distance_mm,peak_mb,mb_per_1k_vertices,converged\n";
-  PlotSeries inflated = series("inflated vs reference", balloon::bench::palette_color(2), false);
-  PlotSeries rest = series("rest meshes (remeshing)", balloon::bench::palette_color(7), true);
-  const auto row = [&](int vertices, const Solve& s, double error_mm, double rest_mm) {
-    const balloon::InflationResult& r = s.result;
-    const double error_pct = 100.0 * error_mm / diag;  // NaN (n/a) when either is
-    const double per_1k = s.peak_mb / (vertices / 1000.0);
-    std::printf("%8d %9.3f %7d %8d %10s %10s %12s %9.1f %10.2f  %s\n", vertices, r.time_s, r.newton_iterations,
-                r.factorizations, cell(error_mm, "%.4f").c_str(), cell(error_pct, "%.4f").c_str(),
-                cell(rest_mm, "%.4f").c_str(), s.peak_mb, per_1k, status(r).c_str());
-    std::fflush(stdout);
-    csv << shape.name << "," << vertices << "," << r.time_s << "," << r.newton_iterations << "," << r.factorizations
-        << "," << cell(error_mm, "%.6g") << "," << cell(error_pct, "%.6g") << "," << cell(rest_mm, "%.6g") << ","
-        << s.peak_mb << "," << per_1k << "," << (r.converged ? "true" : "false") << "\n";
-    if (std::isfinite(error_pct)) {
-      inflated.points.push_back({r.time_s, error_pct});
-      inflated.point_labels.push_back(thousands(vertices));
-    }
-    if (r.converged) rest.points.push_back({r.time_s, 100.0 * rest_mm / diag});  // NaN points are not drawn
+  // The coarse solves first, the reference last, so that no row's peak memory holds the reference.
+  struct Run {
+    balloon::TriMesh rest;
+    Solve solve;
   };
+  std::vector<Run> runs;
   for (const int resolution : resolutions) {
     auto target = prepare(*input, resolution);
     if (!target) {
       std::printf("%8d cannot prepare: %s\n", resolution, target.error().c_str());
       continue;
     }
-    const Solve s = solve(target->mesh, material);
-    double error_mm = NOT_COMPUTED;
-    if (s.result.converged && inflated_reference)
-      error_mm = inflated_reference->stats(align_to_surface(s.result.deformed, *inflated_reference)).avg_mm;
-    row(target->mesh.vertex_count(), s, error_mm, rest_reference.stats(target->mesh.vertices).avg_mm);
+    Solve s = solve(target->mesh, material);
+    runs.push_back({std::move(target->mesh), std::move(s)});
   }
-  row(reference->mesh.vertex_count(), reference_solve, NOT_COMPUTED, NOT_COMPUTED);  // the reference: no error
+  auto reference = prepare(*input, reference_resolution);
+  if (!reference) {
+    std::printf("cannot prepare the reference: %s\n", reference.error().c_str());
+    return panel;
+  }
+  const balloon::TriMesh& reference_rest = reference->mesh;
+  runs.push_back({reference_rest, solve(reference_rest, material)});
+  const balloon::InflationResult& reference_result = runs.back().solve.result;
+  const balloon::TriMesh reference_inflated{reference_result.deformed, reference_rest.faces};
+  std::optional<balloon::SurfaceDistance> inflated_reference;
+  if (reference_result.converged) inflated_reference.emplace(reference_inflated);
+  const balloon::SurfaceDistance rest_reference(reference_rest);
+  const double diag = inflated_reference ? inflated_reference->bbox_diagonal_mm() : NOT_COMPUTED;
+  std::printf("reference inflated: %s, diagonal %s mm (rest %.1f mm)\n", status(reference_result).c_str(),
+              cell(diag, "%.1f").c_str(), reference->bbox_diag_mm);
+  std::printf("(err: two-sided mean distance between the inflated surfaces after a rigid alignment; node_err: this "
+              "mesh's inflated vertices to the reference alone; rest_err: two-sided, the rest meshes)\n");
+  std::printf("%8s %9s %7s %8s %10s %10s %11s %12s %9s %10s  %s\n", "vertices", "time_s", "newton", "factors", "err_mm",
+              "err_%diag", "node_err_mm", "rest_err_mm", "peak_MB", "MB/1k_vert", "status");
+  std::ofstream csv(settings.out_dir + "/forward_organic.csv");
+  csv << "shape,vertices,time_s,newton_iterations,factorizations,mean_distance_mm,mean_distance_pct_diagonal,"
+         "node_distance_mm,rest_mean_distance_mm,peak_mb,mb_per_1k_vertices,converged\n";
+  PlotSeries inflated = series("inflated vs reference", balloon::bench::palette_color(2), false);
+  PlotSeries rest = series("rest meshes (remeshing)", balloon::bench::palette_color(7), true);
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const Run& run = runs[i];
+    const balloon::InflationResult& r = run.solve.result;
+    const int vertices = run.rest.vertex_count();
+    const bool is_reference = i + 1 == runs.size();  // no error: it is what the others are measured against
+    double error_mm = NOT_COMPUTED, node_mm = NOT_COMPUTED, rest_mm = NOT_COMPUTED;
+    if (!is_reference) {
+      rest_mm = two_sided_mean_mm(run.rest, rest_reference, reference_rest);
+      if (r.converged && inflated_reference) {
+        const balloon::TriMesh aligned{align_to_surface(r.deformed, *inflated_reference), run.rest.faces};
+        node_mm = inflated_reference->stats(aligned.vertices).avg_mm;
+        error_mm = two_sided_mean_mm(aligned, *inflated_reference, reference_inflated);
+      }
+    }
+    const double error_pct = 100.0 * error_mm / diag;  // NaN (n/a) when either is
+    const double per_1k = run.solve.peak_mb / (vertices / 1000.0);
+    std::printf("%8d %9.3f %7d %8d %10s %10s %11s %12s %9.1f %10.2f  %s\n", vertices, r.time_s, r.newton_iterations,
+                r.factorizations, cell(error_mm, "%.4f").c_str(), cell(error_pct, "%.4f").c_str(),
+                cell(node_mm, "%.4f").c_str(), cell(rest_mm, "%.4f").c_str(), run.solve.peak_mb, per_1k,
+                status(r).c_str());
+    std::fflush(stdout);
+    csv << shape.name << "," << vertices << "," << r.time_s << "," << r.newton_iterations << "," << r.factorizations
+        << "," << cell(error_mm, "%.6g") << "," << cell(error_pct, "%.6g") << "," << cell(node_mm, "%.6g") << ","
+        << cell(rest_mm, "%.6g") << "," << run.solve.peak_mb << "," << per_1k << "," << (r.converged ? "true" : "false")
+        << "\n";
+    if (std::isfinite(error_pct)) {
+      inflated.points.push_back({r.time_s, error_pct});
+      inflated.point_labels.push_back(thousands(vertices));
+      rest.points.push_back({r.time_s, 100.0 * rest_mm / diag});
+    }
+  }
   panel.series = {inflated, rest};
   return panel;
 }
