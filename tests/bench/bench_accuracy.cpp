@@ -427,21 +427,25 @@ PlotPanel design_shape(const Settings& settings, const balloon::Material& materi
   switches.line = false;
   switches.marker_radius = 5.0;
   switches.hollow = true;
-  std::string front_text;
   int front_vertices = -1;
   for (const CurvePoint* p : all) {
     if (!p->pareto) continue;
     front.points.push_back({p->time_s, p->error_pct});
-    if (p->vertices != front_vertices) {
-      switches.points.push_back({p->time_s, p->error_pct});
-      char buffer[96];
-      std::snprintf(buffer, sizeof(buffer), "%s%s from %.1f s (%.3g%%)", front_text.empty() ? "" : ", ",
-                    thousands(p->vertices).c_str(), p->time_s, p->error_pct);
-      front_text += buffer;
-      front_vertices = p->vertices;
-    }
+    if (p->vertices != front_vertices) switches.points.push_back({p->time_s, p->error_pct});
+    front_vertices = p->vertices;
   }
-  std::printf("%-8s Pareto front: %s\n", shape.name.c_str(), front_text.empty() ? "n/a" : front_text.c_str());
+  // Per resolution: how many front points, over which times and errors (the curves may interleave).
+  std::printf("%-8s Pareto front:", shape.name.c_str());
+  for (const int vertices : vertex_counts) {
+    std::vector<const CurvePoint*> mine;
+    for (const CurvePoint* p : all)
+      if (p->pareto && p->vertices == vertices) mine.push_back(p);
+    if (mine.empty()) std::printf("  %s: none;", thousands(vertices).c_str());
+    else
+      std::printf("  %s: %zu points, %.1f-%.1f s, %.3g%%-%.3g%%;", thousands(vertices).c_str(), mine.size(),
+                  mine.front()->time_s, mine.back()->time_s, mine.front()->error_pct, mine.back()->error_pct);
+  }
+  std::printf("\n");
   panel.series.push_back(front);
   for (std::size_t i = 0; i < curves.size(); ++i) {
     PlotSeries s;
