@@ -12,7 +12,6 @@
 //                     [--max-time S=60] [--volume-ratio R=8] [--method adjoint|alm (default: both)]
 //                     [--quick]   (--quick: bunny only, 1000 vertices, 20 s per design)
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -27,6 +26,7 @@
 #include "jobs/design_job.hpp"
 #include "material/material.hpp"
 #include "mesh/mesh_io.hpp"
+#include "svg_plot.hpp"
 
 namespace {
 
@@ -80,75 +80,19 @@ std::string target_summary(const std::string& material, const std::string& metho
   return buf;
 }
 
-const char* COLORS[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"};
-
 /// Average error (% of the bbox diagonal, log scale) against time (s), one polyline per method.
 std::string svg_plot(const std::string& title, const std::vector<const Run*>& runs) {
-  constexpr double W = 640, H = 400, LEFT = 70, RIGHT = 20, TOP = 40, BOTTOM = 50;
-  double t_max = 1e-3, e_min = 1e300, e_max = 1e-300;
+  balloon::bench::PlotPanel panel;
+  panel.x = {"time (s)", false};
+  panel.y = {"avg error (% of bbox diagonal)", true};
   for (const Run* run : runs) {
+    balloon::bench::PlotSeries series;
+    series.label = balloon::design_method_name(run->result.method);
     const double diag = std::max(run->result.bbox_diag_mm, 1e-12);
-    for (const auto& s : run->result.log) {
-      t_max = std::max(t_max, s.time_s);
-      const double e = 100.0 * s.avg_error_mm / diag;
-      if (e > 0) {
-        e_min = std::min(e_min, e);
-        e_max = std::max(e_max, e);
-      }
-    }
+    for (const auto& s : run->result.log) series.points.push_back({s.time_s, 100.0 * s.avg_error_mm / diag});
+    panel.series.push_back(series);
   }
-  if (e_min > e_max) e_min = 1e-3, e_max = 1.0;
-  const double lo = std::floor(std::log10(e_min)), hi = std::max(lo + 1, std::ceil(std::log10(e_max)));
-  const auto x = [&](double t) { return LEFT + (W - LEFT - RIGHT) * t / t_max; };
-  const auto y = [&](double e) {
-    return TOP + (H - TOP - BOTTOM) * (hi - std::log10(std::max(e, 1e-300))) / (hi - lo);
-  };
-  char buf[512];
-  std::string svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"640\" height=\"400\" font-family=\"sans-serif\" "
-                    "font-size=\"12\">\n<rect width=\"640\" height=\"400\" fill=\"white\"/>\n";
-  std::snprintf(buf, sizeof(buf), "<text x=\"%g\" y=\"20\" font-size=\"14\">%s</text>\n", LEFT, title.c_str());
-  svg += buf;
-  std::snprintf(buf, sizeof(buf),
-                "<rect x=\"%g\" y=\"%g\" width=\"%g\" height=\"%g\" fill=\"none\" stroke=\"black\"/>\n", LEFT, TOP,
-                W - LEFT - RIGHT, H - TOP - BOTTOM);
-  svg += buf;
-  for (int decade = static_cast<int>(lo); decade <= static_cast<int>(hi); ++decade) {
-    const double yy = y(std::pow(10.0, decade));
-    std::snprintf(buf, sizeof(buf),
-                  "<line x1=\"%g\" y1=\"%.1f\" x2=\"%g\" y2=\"%.1f\" stroke=\"#ddd\"/>"
-                  "<text x=\"%g\" y=\"%.1f\" text-anchor=\"end\">1e%d %%</text>\n",
-                  LEFT, yy, W - RIGHT, yy, LEFT - 5, yy + 4, decade);
-    svg += buf;
-  }
-  for (int tick = 0; tick <= 4; ++tick) {
-    const double t = t_max * tick / 4.0;
-    std::snprintf(buf, sizeof(buf), "<text x=\"%.1f\" y=\"%g\" text-anchor=\"middle\">%.3g</text>\n", x(t), H - BOTTOM + 16,
-                  t);
-    svg += buf;
-  }
-  std::snprintf(buf, sizeof(buf),
-                "<text x=\"%g\" y=\"%g\" text-anchor=\"middle\">time (s)</text>\n"
-                "<text x=\"15\" y=\"%g\" transform=\"rotate(-90 15 %g)\" text-anchor=\"middle\">avg error "
-                "(%% of bbox diagonal)</text>\n",
-                LEFT + (W - LEFT - RIGHT) / 2, H - 12, TOP + (H - TOP - BOTTOM) / 2, TOP + (H - TOP - BOTTOM) / 2);
-  svg += buf;
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    const Run& run = *runs[i];
-    const double diag = std::max(run.result.bbox_diag_mm, 1e-12);
-    std::string points;
-    for (const auto& s : run.result.log) {
-      std::snprintf(buf, sizeof(buf), "%.1f,%.1f ", x(s.time_s), y(100.0 * s.avg_error_mm / diag));
-      points += buf;
-    }
-    const char* color = COLORS[i % 4];
-    svg += "<polyline fill=\"none\" stroke-width=\"2\" stroke=\"" + std::string(color) + "\" points=\"" + points + "\"/>\n";
-    std::snprintf(buf, sizeof(buf), "<text x=\"%g\" y=\"%g\" fill=\"%s\">%s</text>\n", W - RIGHT - 90,
-                  TOP + 18 + 16.0 * static_cast<double>(i), color,
-                  balloon::design_method_name(run.result.method).c_str());
-    svg += buf;
-  }
-  svg += "</svg>\n";
-  return svg;
+  return balloon::bench::svg_figure(title, {panel});
 }
 
 }  // namespace

@@ -5,7 +5,6 @@
 // with their own store: wall time against the solver's own time_s, and the process's peak memory.
 // Usage: bench_inflation [DATA_DIR] [--quick] [--cli PATH_TO_BALLOON | --no-cli]
 #include <fcntl.h>
-#include <malloc.h>
 #include <spawn.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -18,77 +17,20 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <map>
 #include <sstream>
-#include <tuple>
 #include <string>
 #include <vector>
 
 #include "design/target_preparation.hpp"
+#include "geodesic_sphere.hpp"
 #include "mesh/icosphere.hpp"
 #include "mesh/mesh_checks.hpp"
 #include "mesh/mesh_geometry.hpp"
 #include "mesh/mesh_io.hpp"
+#include "peak_memory.hpp"
 #include "solve/inflation.hpp"
 
 namespace {
-
-/// Resets the process's peak resident set (Linux: writing 5 to clear_refs), so each row reports its own;
-/// memory the allocator still holds from earlier rows is given back first (else it would count again).
-void reset_peak_memory() {
-  malloc_trim(0);
-  std::ofstream clear("/proc/self/clear_refs");
-  clear << "5";
-}
-
-/// Peak resident set since the last reset (MB): VmHWM.
-double peak_memory_mb() {
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line))
-    if (line.rfind("VmHWM:", 0) == 0) return std::atof(line.c_str() + 6) / 1024.0;
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;
-}
-
-/// A geodesic sphere of frequency n (each icosahedron face cut into n^2 triangles, projected): 10 n^2 + 2
-/// vertices, faces counter-clockwise seen from outside.
-balloon::TriMesh geodesic_sphere(double radius_mm, int n) {
-  const balloon::TriMesh ico = balloon::make_icosphere(1.0, 0);
-  std::vector<Eigen::Vector3d> points;
-  std::map<std::tuple<long long, long long, long long>, int> index;
-  auto vertex = [&](Eigen::Vector3d p) {
-    p = p.normalized() * radius_mm;
-    const auto key = std::make_tuple(std::llround(p.x() * 1e6), std::llround(p.y() * 1e6), std::llround(p.z() * 1e6));
-    const auto [it, added] = index.emplace(key, static_cast<int>(points.size()));
-    if (added) points.push_back(p);
-    return it->second;
-  };
-  std::vector<Eigen::Vector3i> faces;
-  for (int f = 0; f < ico.face_count(); ++f) {
-    const Eigen::Vector3d a = ico.vertices.row(ico.faces(f, 0)).transpose();
-    const Eigen::Vector3d b = ico.vertices.row(ico.faces(f, 1)).transpose();
-    const Eigen::Vector3d c = ico.vertices.row(ico.faces(f, 2)).transpose();
-    std::vector<std::vector<int>> id(static_cast<size_t>(n) + 1);
-    for (int i = 0; i <= n; ++i)
-      for (int j = 0; j <= n - i; ++j) id[static_cast<size_t>(i)].push_back(vertex(a + (b - a) * i / n + (c - a) * j / n));
-    for (int i = 0; i < n; ++i)
-      for (int j = 0; j < n - i; ++j) {
-        const auto& row = id[static_cast<size_t>(i)];
-        const auto& next = id[static_cast<size_t>(i) + 1];
-        faces.emplace_back(row[static_cast<size_t>(j)], next[static_cast<size_t>(j)], row[static_cast<size_t>(j) + 1]);
-        if (i + j + 1 < n)
-          faces.emplace_back(next[static_cast<size_t>(j)], next[static_cast<size_t>(j) + 1], row[static_cast<size_t>(j) + 1]);
-      }
-  }
-  balloon::TriMesh mesh;
-  mesh.vertices.resize(static_cast<Eigen::Index>(points.size()), 3);
-  for (size_t v = 0; v < points.size(); ++v) mesh.vertices.row(static_cast<Eigen::Index>(v)) = points[v].transpose();
-  mesh.faces.resize(static_cast<Eigen::Index>(faces.size()), 3);
-  for (size_t f = 0; f < faces.size(); ++f) mesh.faces.row(static_cast<Eigen::Index>(f)) = faces[f].transpose();
-  return mesh;
-}
 
 struct ProcessRun {
   int exit_code = -1;
@@ -153,7 +95,7 @@ void end_to_end(const std::string& cli, bool quick) {
   std::vector<int> frequencies = {6};
   if (!quick) frequencies.push_back(100);
   for (const int n : frequencies) {
-    const balloon::TriMesh sphere = geodesic_sphere(50.0, n);
+    const balloon::TriMesh sphere = balloon::bench::geodesic_sphere(50.0, n);
     const std::string mesh_path = (dir / ("sphere" + std::to_string(sphere.vertex_count()) + ".obj")).string();
     if (auto written = balloon::write_mesh(sphere, mesh_path); !written) {
       std::printf("cannot write %s: %s\n", mesh_path.c_str(), written.error().c_str());
@@ -198,9 +140,9 @@ Row run(const std::string& name, const balloon::TriMesh& mesh, const balloon::Ma
   options.control = balloon::InflationControl::VolumeRatio;
   options.volume_ratio = 8.0;
   options.max_time_s = 300;
-  reset_peak_memory();
+  balloon::bench::reset_peak_memory();
   Row row{name, mesh.vertex_count(), balloon::inflate(mesh, options)};
-  const double peak_mb = peak_memory_mb();
+  const double peak_mb = balloon::bench::peak_memory_mb();
   std::printf("%-28s %8d %9.3f %7d %8d %6d %10.3g %9.2f %9.1f %10.2f  %s\n", name.c_str(), row.vertices,
               row.result.time_s, row.result.newton_iterations, row.result.factorizations, row.result.load_steps,
               row.result.residual_norm, row.result.pressure_kpa, peak_mb, peak_mb / (row.vertices / 1000.0),
