@@ -255,7 +255,9 @@ NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressur
 bool EquilibriumSolver::factorize_exact_for_volume(const Eigen::VectorXd& x, double pressure_mpa,
                                                    const Eigen::VectorXd& v) {
   m_model.assemble_hessian(x, pressure_mpa, m_assembly, false);
-  if (m_solver.factorize_llt(m_assembly.values()) == SparseSolver::Status::Ok) {
+  // Once the exact stiffness was indefinite (past a pressure maximum, say), go straight to LDL^T: a
+  // failed LL^T attempt first would cost a factorization for nothing.
+  if (!m_exact_indefinite && m_solver.factorize_llt(m_assembly.values()) == SparseSolver::Status::Ok) {
     m_last_unstable_modes = 0;
     return true;
   }
@@ -263,12 +265,12 @@ bool EquilibriumSolver::factorize_exact_for_volume(const Eigen::VectorXd& x, dou
     --m_skip_ldlt;
     return false;
   }
-  // The simplicial LDL^T costs several supernodal LL^T: only worth it close to a solution.
-  if (m_sqp_unshifted_steps == 0) return false;
   if (m_solver.factorize_ldlt(m_assembly.values()) != SparseSolver::Status::Ok) {
+    m_exact_indefinite = false;
     m_skip_ldlt = 2;
     return false;
   }
+  m_exact_indefinite = m_solver.negative_pivots() > 0;
   // Inertia of the bordered KKT matrix [K v; v^T 0] (Haynsworth): In(K) plus the sign of -v^T K^-1 v.
   // A stable volume-controlled state has exactly one negative eigenvalue there (the constraint's); each
   // more is an unstable direction (a wrinkling or symmetry-breaking mode). Newton still converges to such
