@@ -32,10 +32,14 @@ struct SparseSolver::Internals {
     cholmod_finish(&common);
   }
 
-  void copy_values(const std::vector<double>& values) {
+  /// The values fit the pattern and are finite (neither factorization checks).
+  void check_values(const std::vector<double>& values) const {
     if (values.size() != matrix->nzmax) throw std::invalid_argument("SparseSolver: value count does not match the pattern");
     for (double v : values)
       if (!std::isfinite(v)) throw std::invalid_argument("SparseSolver: non-finite matrix entry");
+  }
+  void copy_values(const std::vector<double>& values) {
+    check_values(values);
     std::memcpy(matrix->x, values.data(), values.size() * sizeof(double));
   }
 };
@@ -83,7 +87,7 @@ SparseSolver::Status SparseSolver::factorize_llt(const std::vector<double>& valu
 }
 
 SparseSolver::Status SparseSolver::factorize_ldlt(const std::vector<double>& values, double shift) {
-  m->copy_values(values);  // checks the values are finite
+  m->check_values(values);
   m->last = nullptr;
   m->ldlt_is_last = false;
   m->negative = 0;
