@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <vector>
 
+#include "contract/xml_text.hpp"
+
 namespace balloon::contract {
 namespace {
 
@@ -21,20 +23,6 @@ std::string fixed(double value, const char* pattern = "%.1f") {
   char buffer[48];
   std::snprintf(buffer, sizeof(buffer), pattern, value);
   return buffer;
-}
-
-std::string escaped(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
 }
 
 /// 1, 2, 5 times a power of ten: the tick step that gives about `count` ticks over `span`.
@@ -110,7 +98,7 @@ std::string curve_svg(const v1::CurveReport& report) {
   std::string title = "Pressure-volume curve: " + report.material();
   if (!report.material_name().empty()) title += " (" + report.material_name() + ")";
   title += ", h = " + number(report.thickness_mm()) + " mm, " + std::to_string(report.vertices()) + " vertices";
-  svg += "<text x=\"" + fixed(LEFT) + "\" y=\"22\" font-weight=\"bold\">" + escaped(title) + "</text>\n";
+  svg += "<text x=\"" + fixed(LEFT) + "\" y=\"22\" font-weight=\"bold\">" + xml_escaped(title) + "</text>\n";
   svg += "<rect x=\"" + fixed(LEFT) + "\" y=\"" + fixed(TOP) + "\" width=\"" + fixed(plot_w) + "\" height=\"" +
          fixed(plot_h) + "\" fill=\"none\" stroke=\"#888\"/>\n";
   // Log ticks at 1, 2, 5 per decade (every decade only when they would crowd).

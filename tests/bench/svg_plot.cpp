@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <limits>
 
+#include "contract/xml_text.hpp"
+
 namespace balloon::bench {
 namespace {
 
@@ -22,20 +24,6 @@ std::string tick_text(double value) {
   char buffer[32];
   std::snprintf(buffer, sizeof(buffer), "%g", std::abs(value) < 1e-12 ? 0.0 : value);
   return buffer;
-}
-
-std::string escaped(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
 }
 
 /// 1, 2 or 5 times a power of ten: the largest at or below `value` (down) or the smallest at or above it.
@@ -116,7 +104,7 @@ std::string panel_svg(const PlotPanel& panel, double left, double top) {
   const Scale sx = fit_scale(panel.x, xs, x0, x0 + PLOT_W);
   const Scale sy = fit_scale(panel.y, ys, y0 + PLOT_H, y0);
   std::string svg = "<text x=\"" + fixed(x0) + "\" y=\"" + fixed(top + 20) + "\" font-size=\"13\" font-weight=\"bold\">" +
-                    escaped(panel.title) + "</text>\n";
+                    contract::xml_escaped(panel.title) + "</text>\n";
   svg += "<rect x=\"" + fixed(x0) + "\" y=\"" + fixed(y0) + "\" width=\"" + fixed(PLOT_W) + "\" height=\"" + fixed(PLOT_H) +
          "\" fill=\"none\" stroke=\"#888\"/>\n";
   for (const double tick : sx.ticks()) {
@@ -132,9 +120,9 @@ std::string panel_svg(const PlotPanel& panel, double left, double top) {
            "\" text-anchor=\"end\">" + tick_text(tick) + "</text>\n";
   }
   svg += "<text x=\"" + fixed(x0 + PLOT_W / 2) + "\" y=\"" + fixed(y0 + PLOT_H + 36) + "\" text-anchor=\"middle\">" +
-         escaped(panel.x.label + (panel.x.log ? ", log scale" : "")) + "</text>\n";
+         contract::xml_escaped(panel.x.label + (panel.x.log ? ", log scale" : "")) + "</text>\n";
   svg += "<text transform=\"translate(" + fixed(left + 16) + "," + fixed(y0 + PLOT_H / 2) +
-         ") rotate(-90)\" text-anchor=\"middle\">" + escaped(panel.y.label + (panel.y.log ? ", log scale" : "")) +
+         ") rotate(-90)\" text-anchor=\"middle\">" + contract::xml_escaped(panel.y.label + (panel.y.log ? ", log scale" : "")) +
          "</text>\n";
   bool any = false;
   double legend_y = y0 + 8;
@@ -151,7 +139,7 @@ std::string panel_svg(const PlotPanel& panel, double left, double top) {
       pixels.push_back({sx(p[0]), sy(p[1])});
       if (k < series.point_labels.size() && !series.point_labels[k].empty())
         svg += "<text x=\"" + fixed(sx(p[0]) + 6) + "\" y=\"" + fixed(sy(p[1]) - 6) + "\" font-size=\"10\" fill=\"" +
-               color + "\">" + escaped(series.point_labels[k]) + "</text>\n";
+               color + "\">" + contract::xml_escaped(series.point_labels[k]) + "</text>\n";
     }
     any = any || !pixels.empty();
     if (series.line && pixels.size() >= 2) {
@@ -173,7 +161,7 @@ std::string panel_svg(const PlotPanel& panel, double left, double top) {
     if (series.marker_radius > 0)
       svg += "<circle cx=\"" + fixed(lx + 11) + "\" cy=\"" + fixed(legend_y) + "\" r=\"" + fixed(series.marker_radius) +
              "\" " + fill + "/>\n";
-    svg += "<text x=\"" + fixed(lx + 28) + "\" y=\"" + fixed(legend_y + 4) + "\">" + escaped(series.label) + "</text>\n";
+    svg += "<text x=\"" + fixed(lx + 28) + "\" y=\"" + fixed(legend_y + 4) + "\">" + contract::xml_escaped(series.label) + "</text>\n";
     legend_y += 17;
   }
   if (!any)
@@ -200,13 +188,13 @@ std::string svg_figure(const std::string& title, const std::vector<PlotPanel>& p
                height = FIGURE_TOP + PANEL_H * rows + FIGURE_BOTTOM;
   std::string svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + fixed(width) + "\" height=\"" + fixed(height) +
                     "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  svg += "<text x=\"" + fixed(LEFT) + "\" y=\"22\" font-size=\"15\" font-weight=\"bold\">" + escaped(title) + "</text>\n";
+  svg += "<text x=\"" + fixed(LEFT) + "\" y=\"22\" font-size=\"15\" font-weight=\"bold\">" + contract::xml_escaped(title) + "</text>\n";
   for (std::size_t i = 0; i < panels.size(); ++i) {
     const int row = static_cast<int>(i) / columns, column = static_cast<int>(i) % columns;
     svg += panel_svg(panels[i], PANEL_W * column, FIGURE_TOP + PANEL_H * row);
   }
   if (!note.empty())
-    svg += "<text x=\"" + fixed(LEFT) + "\" y=\"" + fixed(height - 8) + "\" fill=\"#666\">" + escaped(note) + "</text>\n";
+    svg += "<text x=\"" + fixed(LEFT) + "\" y=\"" + fixed(height - 8) + "\" fill=\"#666\">" + contract::xml_escaped(note) + "</text>\n";
   svg += "</svg>\n";
   return svg;
 }
