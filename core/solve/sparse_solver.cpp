@@ -15,9 +15,9 @@ struct SparseSolver::Internals {
   cholmod_common common{};
   cholmod_sparse* matrix = nullptr;
   cholmod_factor* llt = nullptr;   // supernodal symbolic + numeric
-  cholmod_factor* last = nullptr;  // the CHOLMOD factor solve() uses, when the last factorization was LL^T
   std::unique_ptr<IndefiniteFactorization> ldlt;  // symmetric indefinite matrices; made at first use
-  bool ldlt_is_last = false;       // solve() uses `ldlt`
+  enum class Factor { None, Llt, Ldlt };
+  Factor last = Factor::None;  // the successful factorization solve() uses
   int n = 0;
   int negative = 0;
 
@@ -50,8 +50,7 @@ SparseSolver::~SparseSolver() = default;
 void SparseSolver::set_pattern(int n, const std::vector<int>& column_starts, const std::vector<int>& row_indices) {
   if (m->llt) cholmod_free_factor(&m->llt, &m->common);
   if (m->matrix) cholmod_free_sparse(&m->matrix, &m->common);
-  m->last = nullptr;
-  m->ldlt_is_last = false;
+  m->last = Internals::Factor::None;
   m->ldlt.reset();
   m->n = n;
   m->matrix = cholmod_allocate_sparse(static_cast<size_t>(n), static_cast<size_t>(n), row_indices.size(), 1, 1, 1,
@@ -63,6 +62,7 @@ void SparseSolver::set_pattern(int n, const std::vector<int>& column_starts, con
 
 SparseSolver::Status SparseSolver::factorize_llt(const std::vector<double>& values, double shift) {
   m->copy_values(values);
+  m->last = Internals::Factor::None;
   if (!m->llt) {
     m->common.supernodal = CHOLMOD_SUPERNODAL;
     m->common.final_ll = 1;
@@ -74,22 +74,17 @@ SparseSolver::Status SparseSolver::factorize_llt(const std::vector<double>& valu
   m->common.quick_return_if_not_posdef = 1;
   double beta[2] = {shift, 0.0};
   ++m_factorizations;
-  m->ldlt_is_last = false;
   const int ok = cholmod_factorize_p(m->matrix, beta, nullptr, 0, m->llt, &m->common);
   m->negative = 0;
   if (!ok) return Status::Failed;
-  if (m->common.status == CHOLMOD_NOT_POSDEF || m->llt->minor < m->llt->n) {
-    m->last = nullptr;
-    return Status::NotPositiveDefinite;
-  }
-  m->last = m->llt;
+  if (m->common.status == CHOLMOD_NOT_POSDEF || m->llt->minor < m->llt->n) return Status::NotPositiveDefinite;
+  m->last = Internals::Factor::Llt;
   return Status::Ok;
 }
 
 SparseSolver::Status SparseSolver::factorize_ldlt(const std::vector<double>& values, double shift) {
   m->check_values(values);
-  m->last = nullptr;
-  m->ldlt_is_last = false;
+  m->last = Internals::Factor::None;
   m->negative = 0;
   if (!m->ldlt) {
     const auto* starts = static_cast<const int*>(m->matrix->p);
@@ -105,17 +100,17 @@ SparseSolver::Status SparseSolver::factorize_ldlt(const std::vector<double>& val
     case IndefiniteFactorization::Status::Failed: return Status::Failed;
   }
   m->negative = m->ldlt->negative_pivots();
-  m->ldlt_is_last = true;
+  m->last = Internals::Factor::Ldlt;
   return Status::Ok;
 }
 
 int SparseSolver::negative_pivots() const { return m->negative; }
 
 Eigen::VectorXd SparseSolver::solve(const Eigen::VectorXd& rhs) const {
-  if (!m->last && !m->ldlt_is_last) throw std::logic_error("SparseSolver::solve without a successful factorization");
+  if (m->last == Internals::Factor::None) throw std::logic_error("SparseSolver::solve without a successful factorization");
   if (rhs.size() != m->n) throw std::invalid_argument("SparseSolver::solve: size mismatch");
   if (!rhs.allFinite()) throw std::invalid_argument("SparseSolver::solve: non-finite right-hand side");
-  if (m->ldlt_is_last) return m->ldlt->solve(rhs);
+  if (m->last == Internals::Factor::Ldlt) return m->ldlt->solve(rhs);
   cholmod_dense b{};
   b.nrow = static_cast<size_t>(m->n);
   b.ncol = 1;
@@ -124,7 +119,7 @@ Eigen::VectorXd SparseSolver::solve(const Eigen::VectorXd& rhs) const {
   b.x = const_cast<double*>(rhs.data());
   b.xtype = CHOLMOD_REAL;
   b.dtype = CHOLMOD_DOUBLE;
-  cholmod_dense* x = cholmod_solve(CHOLMOD_A, m->last, &b, &m->common);
+  cholmod_dense* x = cholmod_solve(CHOLMOD_A, m->llt, &b, &m->common);
   if (!x) throw std::runtime_error("SparseSolver::solve: CHOLMOD solve failed");
   Eigen::VectorXd out = Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(x->x), m->n);
   cholmod_free_dense(&x, &m->common);
