@@ -85,8 +85,14 @@ bool EquilibriumSolver::factorize_at(const Eigen::VectorXd& x, double pressure_m
 
 bool EquilibriumSolver::factorize_exact(const Eigen::VectorXd& x, double pressure_mpa) {
   m_model.assemble_hessian(x, pressure_mpa, m_assembly, false);
-  if (m_solver.factorize_llt(m_assembly.values()) == SparseSolver::Status::Ok) return true;
-  return m_solver.factorize_ldlt(m_assembly.values()) == SparseSolver::Status::Ok;
+  if (!m_exact_indefinite && m_solver.factorize_llt(m_assembly.values()) == SparseSolver::Status::Ok) return true;
+  return factorize_exact_ldlt();
+}
+
+bool EquilibriumSolver::factorize_exact_ldlt() {
+  const bool ok = m_solver.factorize_ldlt(m_assembly.values()) == SparseSolver::Status::Ok;
+  m_exact_indefinite = ok && m_solver.negative_pivots() > 0;
+  return ok;
 }
 
 Eigen::VectorXd EquilibriumSolver::stiffness_times(const Eigen::VectorXd& x, double pressure_mpa,
@@ -255,8 +261,6 @@ NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressur
 bool EquilibriumSolver::factorize_exact_for_volume(const Eigen::VectorXd& x, double pressure_mpa,
                                                    const Eigen::VectorXd& v) {
   m_model.assemble_hessian(x, pressure_mpa, m_assembly, false);
-  // Once the exact stiffness was indefinite (past a pressure maximum, say), go straight to LDL^T: a
-  // failed LL^T attempt first would cost a factorization for nothing.
   if (!m_exact_indefinite && m_solver.factorize_llt(m_assembly.values()) == SparseSolver::Status::Ok) {
     m_last_unstable_modes = 0;
     return true;
@@ -265,12 +269,10 @@ bool EquilibriumSolver::factorize_exact_for_volume(const Eigen::VectorXd& x, dou
     --m_skip_ldlt;
     return false;
   }
-  if (m_solver.factorize_ldlt(m_assembly.values()) != SparseSolver::Status::Ok) {
-    m_exact_indefinite = false;
+  if (!factorize_exact_ldlt()) {
     m_skip_ldlt = 2;
     return false;
   }
-  m_exact_indefinite = m_solver.negative_pivots() > 0;
   // Inertia of the bordered KKT matrix [K v; v^T 0] (Haynsworth): In(K) plus the sign of -v^T K^-1 v.
   // A stable volume-controlled state has exactly one negative eigenvalue there (the constraint's); each
   // more is an unstable direction (a wrinkling or symmetry-breaking mode). Newton still converges to such

@@ -74,7 +74,8 @@ class EquilibriumSolver {
 
   /// Factorizes the exact Hessian of W - p V at x (free coordinates). True if it is positive definite.
   bool factorize_at(const Eigen::VectorXd& x, double pressure_mpa);
-  /// Factorizes the exact Hessian at x, indefinite allowed (LL^T, else LDL^T). False if singular.
+  /// Factorizes the exact Hessian at x, indefinite allowed (LL^T, else LDL^T; straight to LDL^T once the
+  /// exact Hessian was indefinite, since the LL^T attempt would only fail again). False if singular.
   bool factorize_exact(const Eigen::VectorXd& x, double pressure_mpa);
   /// K(x, p) w for full 3#V vectors (fixed coordinates ignored / zero), assembling K at x.
   Eigen::VectorXd stiffness_times(const Eigen::VectorXd& x, double pressure_mpa, const Eigen::VectorXd& w);
@@ -98,6 +99,8 @@ class EquilibriumSolver {
   /// Lagrangian at the new multiplier or on a clear fall of the KKT residual. False if no step helped.
   bool constrained_descent(Eigen::VectorXd& x, double& pressure_mpa, double target_volume, const Eigen::VectorXd& v,
                            const Eigen::VectorXd& r, double c);
+  /// LDL^T of the exact stiffness assembled last; records whether it was indefinite.
+  bool factorize_exact_ldlt();
   /// Exact stiffness for the volume-controlled KKT step, accepted when its inertia is right.
   bool factorize_exact_for_volume(const Eigen::VectorXd& x, double pressure_mpa, const Eigen::VectorXd& v);
 

@@ -46,7 +46,7 @@ struct PathPoint {
 };
 
 /// The inertia of the exact stiffness, for states EquilibriumSolver's positive definite test rejects:
-/// its own assembly and simplicial LDL^T, so the solver's factorization and state are left alone.
+/// its own assembly and LDL^T, so the solver's factorization and state are left alone.
 class Inertia {
  public:
   Inertia(const fem::BalloonModel& model, const std::vector<bool>& fixed)
@@ -132,7 +132,7 @@ class InflationRun {
 
   /// Unstable directions of the current state under pressure control: the negative eigenvalues of the
   /// stiffness K = Hess(W - p V) over the free coordinates (0 when K is positive definite). One
-  /// supernodal LL^T; the simplicial LDL^T for the inertia only when that fails. -1 when K is singular.
+  /// supernodal LL^T; the LDL^T for the inertia only when that fails. -1 when K is singular.
   int pressure_unstable_modes() {
     if (m_solver.factorize_at(m_state.x, m_state.pressure)) return 0;
     if (!m_inertia) m_inertia = std::make_unique<Inertia>(m_model, m_fixed);
