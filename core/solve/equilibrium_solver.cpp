@@ -295,13 +295,10 @@ bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, doubl
   // direction that the volume constraint removes: past a pressure maximum); otherwise with the
   // smallest Levenberg shift that makes H positive definite, kept from step to step.
   double shift = 0.0;
-  // As for the exact stiffness: once the model was indefinite, its LL^T attempt would only fail again.
-  bool factorized = !m_model_indefinite && m_solver.factorize_llt(m_assembly.values()) == SparseSolver::Status::Ok;
-  if (!factorized) {
-    const bool inertia_known = m_solver.factorize_ldlt(m_assembly.values()) == SparseSolver::Status::Ok;
-    m_model_indefinite = inertia_known && m_solver.negative_pivots() > 0;
-    factorized = inertia_known && kkt_negative_eigenvalues(v) == 1;
-  }
+  bool factorized = m_solver.factorize_llt(m_assembly.values()) == SparseSolver::Status::Ok;
+  if (!factorized && m_solver.factorize_ldlt(m_assembly.values()) == SparseSolver::Status::Ok &&
+      kkt_negative_eigenvalues(v) == 1)
+    factorized = true;
   if (!factorized) shift = std::max(0.25 * m_sqp_shift, 1e-6 * base);
   while (!factorized) {
     if (shift > 1e8 * base) return false;

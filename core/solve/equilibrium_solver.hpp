@@ -114,7 +114,6 @@ class EquilibriumSolver {
   int m_sqp_unshifted_steps = 0;        ///< consecutive unshifted SQP steps: close enough for the exact step
   bool m_last_step_exact = false;  ///< the last volume step was the exact one
   bool m_exact_indefinite = false;  ///< the last exact stiffness had negative pivots: skip the LL^T attempt
-  bool m_model_indefinite = false;  ///< the last SQP model had negative pivots: skip its LL^T attempt
   double m_force_floor = 0.0;  ///< N, see force_scale()
 };
 
