@@ -87,6 +87,9 @@ std::string summary_from_report(const v1::SimulateReport& report) {
   if (report.unstable_modes() > 0)
     out << "  stability      a saddle under volume control: " << report.unstable_modes()
         << " unstable direction(s) (wrinkling or symmetry breaking; the real balloon may take another shape)\n";
+  if (report.bending())
+    out << "  bending        on: the membrane alone wrinkled with no stable state, so the sheet's bending\n"
+           "                 stiffness (G h^3 / 3) was added\n";
   out << "  material       " << report.material();
   if (!report.material_name().empty()) out << " (" << report.material_name() << ")";
   out << ", thickness " << format("%.6g", report.thickness_mm()) << " mm\n";

@@ -6,37 +6,47 @@
 
 namespace balloon::fem {
 
-TriangleAssembly::TriangleAssembly(const Faces& faces, int vertex_count, const std::vector<bool>& fixed_coordinate) {
+TriangleAssembly::TriangleAssembly(const Faces& faces, int vertex_count, const std::vector<bool>& fixed_coordinate,
+                                   const std::vector<HingeVertices>& hinges) {
   if (static_cast<int>(fixed_coordinate.size()) != 3 * vertex_count)
     throw std::invalid_argument("TriangleAssembly: fixed_coordinate must have 3#V entries");
   number_free_coordinates(fixed_coordinate);
 
-  // Rows of each column: the free coordinates of all vertices sharing a triangle, upper part only.
+  // Rows of each column: the free coordinates of all vertices sharing a triangle or a hinge, upper part only.
   std::vector<std::vector<int>> rows_of_column(static_cast<size_t>(m_free_count));
-  auto corner_coordinate = [&](int face, int k) { return 3 * faces(face, k / 3) + k % 3; };
-  for (int f = 0; f < faces.rows(); ++f) {
-    for (int k = 0; k < 9; ++k) {
-      const int col = m_free_index[static_cast<size_t>(corner_coordinate(f, k))];
+  auto add_stencil = [&](const int* vertices, int corners) {
+    for (int k = 0; k < 3 * corners; ++k) {
+      const int col = m_free_index[static_cast<size_t>(3 * vertices[k / 3] + k % 3)];
       if (col < 0) continue;
-      for (int l = 0; l < 9; ++l) {
-        const int row = m_free_index[static_cast<size_t>(corner_coordinate(f, l))];
+      for (int l = 0; l < 3 * corners; ++l) {
+        const int row = m_free_index[static_cast<size_t>(3 * vertices[l / 3] + l % 3)];
         if (row >= 0 && row <= col) rows_of_column[static_cast<size_t>(col)].push_back(row);
       }
     }
+  };
+  for (int f = 0; f < faces.rows(); ++f) add_stencil(&faces(f, 0), 3);
+  for (const auto& hinge : hinges) {
+    for (int v : hinge)
+      if (v < 0 || v >= vertex_count) throw std::invalid_argument("TriangleAssembly: a hinge vertex does not exist");
+    add_stencil(hinge.data(), 4);
   }
   set_pattern(rows_of_column);
 
-  m_element_slots.assign(static_cast<size_t>(faces.rows()) * 81, -1);
-  for (int f = 0; f < faces.rows(); ++f) {
-    for (int k = 0; k < 9; ++k) {
-      const int col = m_free_index[static_cast<size_t>(corner_coordinate(f, k))];
-      if (col < 0) continue;
-      for (int l = 0; l < 9; ++l) {
-        const int row = m_free_index[static_cast<size_t>(corner_coordinate(f, l))];
-        if (row >= 0 && row <= col) m_element_slots[static_cast<size_t>(f) * 81 + static_cast<size_t>(l + 9 * k)] = slot(row, col);
+  // Slot of every stencil entry (l, k), column-major as the element blocks store it; -1 when skipped.
+  auto stencil_slots = [&](const int* vertices, int corners, int* slots) {
+    const int n = 3 * corners;
+    for (int k = 0; k < n; ++k) {
+      const int col = m_free_index[static_cast<size_t>(3 * vertices[k / 3] + k % 3)];
+      for (int l = 0; l < n; ++l) {
+        const int row = m_free_index[static_cast<size_t>(3 * vertices[l / 3] + l % 3)];
+        slots[l + n * k] = col >= 0 && row >= 0 && row <= col ? slot(row, col) : -1;
       }
     }
-  }
+  };
+  m_element_slots.assign(static_cast<size_t>(faces.rows()) * 81, -1);
+  for (int f = 0; f < faces.rows(); ++f) stencil_slots(&faces(f, 0), 3, &m_element_slots[static_cast<size_t>(f) * 81]);
+  m_hinge_slots.assign(hinges.size() * 144, -1);
+  for (size_t h = 0; h < hinges.size(); ++h) stencil_slots(hinges[h].data(), 4, &m_hinge_slots[h * 144]);
 }
 
 TriangleAssembly::TriangleAssembly(const std::vector<std::vector<int>>& vertex_groups, int vertex_count,
@@ -101,6 +111,13 @@ void TriangleAssembly::add(int face, const Matrix9d& block) {
   const int* slots = &m_element_slots[static_cast<size_t>(face) * 81];
   const double* entries = block.data();  // column-major: entry (l, k) at l + 9 k
   for (int i = 0; i < 81; ++i)
+    if (slots[i] >= 0) m_values[static_cast<size_t>(slots[i])] += entries[i];
+}
+
+void TriangleAssembly::add_hinge(int hinge, const Matrix12d& block) {
+  const int* slots = &m_hinge_slots.at(static_cast<size_t>(hinge) * 144);
+  const double* entries = block.data();
+  for (int i = 0; i < 144; ++i)
     if (slots[i] >= 0) m_values[static_cast<size_t>(slots[i])] += entries[i];
 }
 

@@ -5,17 +5,20 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "fem/hinge_bending.hpp"
 #include "fem/membrane_element.hpp"
 #include "mesh/tri_mesh.hpp"
 
 namespace balloon::fem {
 
 /// Upper triangle (row <= column) of a symmetric matrix over the free coordinates, in compressed-column
-/// form, plus the slots of every triangle's 9x9 block.
+/// form, plus the slots of every triangle's 9x9 block (and every bending hinge's 12x12 block).
 class TriangleAssembly {
  public:
   /// `fixed_coordinate` has 3#V entries (x0, y0, z0, x1, ...); fixed coordinates get no row or column.
-  TriangleAssembly(const Faces& faces, int vertex_count, const std::vector<bool>& fixed_coordinate);
+  /// `hinges` (bending on) widens the pattern to the vertices across each edge.
+  TriangleAssembly(const Faces& faces, int vertex_count, const std::vector<bool>& fixed_coordinate,
+                   const std::vector<HingeVertices>& hinges = {});
   /// A pattern wider than one triangle: every two vertices of one group couple (e.g. each vertex with
   /// its one-ring, for a Gauss-Newton J^T J whose rows are per vertex). Filled with add_block and
   /// add_entry; add() needs the triangle constructor.
@@ -33,6 +36,8 @@ class TriangleAssembly {
   void set_zero();
   /// Adds a symmetric 9x9 block of triangle `face` (its corners in face order).
   void add(int face, const Matrix9d& block);
+  /// Adds a symmetric 12x12 block of hinge `hinge` (index into the constructor's hinges).
+  void add_hinge(int hinge, const Matrix12d& block);
   /// Adds a symmetric block over `coordinates` (block(i, j) at coordinates i, j): its upper triangle in
   /// the free numbering, fixed coordinates skipped. Every pair must be in the pattern (else
   /// std::out_of_range). Looks each entry up: for blocks other than the triangles' own.
@@ -69,6 +74,7 @@ class TriangleAssembly {
   std::vector<double> m_values;
   std::vector<int> m_diagonal_slots;
   std::vector<int> m_element_slots;  // 81 per face, -1 for skipped entries
+  std::vector<int> m_hinge_slots;    // 144 per hinge, likewise
 };
 
 }  // namespace balloon::fem

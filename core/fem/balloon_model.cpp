@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
+#include <utility>
 #include <stdexcept>
 
 #include "fem/pressure_load.hpp"
@@ -26,6 +28,36 @@ void BalloonModel::set_rest_positions(const Positions& rest) {
     m_rest_triangles[static_cast<size_t>(f)] = make_rest_triangle(corners(x, f));
     m_rest_area += m_rest_triangles[static_cast<size_t>(f)].area;
   }
+  if (m_bending) update_rest_hinges();
+}
+
+void BalloonModel::set_bending(bool on) {
+  m_bending = on;
+  m_hinges = on ? mesh_hinges(m_faces) : std::vector<HingeVertices>{};
+  if (on) update_rest_hinges();
+  else m_rest_hinges.clear();
+}
+
+void BalloonModel::update_rest_hinges() {
+  // Per hinge, the bending modulus of the mean thickness of its two triangles; the small-strain G.
+  std::map<std::pair<int, int>, int> face_of_edge;
+  for (int f = 0; f < m_faces.rows(); ++f)
+    for (int k = 0; k < 3; ++k) face_of_edge[{m_faces(f, k), m_faces(f, (k + 1) % 3)}] = f;
+  const Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(m_rest.data(), m_rest.size());
+  m_rest_hinges.resize(m_hinges.size());
+  for (size_t h = 0; h < m_hinges.size(); ++h) {
+    const auto& v = m_hinges[h];
+    const double thickness = 0.5 * (m_thickness[static_cast<size_t>(face_of_edge.at({v[0], v[1]}))] +
+                                    m_thickness[static_cast<size_t>(face_of_edge.at({v[1], v[0]}))]);
+    m_rest_hinges[h] = make_rest_hinge(hinge_corners(x, static_cast<int>(h)),
+                                       bending_modulus(m_material.shear_modulus(), thickness));
+  }
+}
+
+Vector12d BalloonModel::hinge_corners(const Eigen::VectorXd& x, int hinge) const {
+  Vector12d c;
+  for (int k = 0; k < 4; ++k) c.segment<3>(3 * k) = x.segment<3>(3 * m_hinges[static_cast<size_t>(hinge)][static_cast<size_t>(k)]);
+  return c;
 }
 
 Vector9d BalloonModel::corners(const Eigen::VectorXd& x, int face) const {
@@ -41,7 +73,9 @@ double BalloonModel::elastic_energy(const Eigen::VectorXd& x) const {
                              corners(x, f), m_tension_field);
     if (!std::isfinite(total)) return std::numeric_limits<double>::infinity();
   }
-  return total;
+  for (size_t h = 0; h < m_hinges.size(); ++h)
+    total += hinge_energy(m_rest_hinges[h], hinge_corners(x, static_cast<int>(h)));
+  return std::isfinite(total) ? total : std::numeric_limits<double>::infinity();
 }
 
 Eigen::VectorXd BalloonModel::elastic_gradient(const Eigen::VectorXd& x) const {
@@ -50,6 +84,10 @@ Eigen::VectorXd BalloonModel::elastic_gradient(const Eigen::VectorXd& x) const {
     const Vector9d ge = membrane_gradient(m_material, m_thickness[static_cast<size_t>(f)],
                                           m_rest_triangles[static_cast<size_t>(f)], corners(x, f), m_tension_field);
     for (int k = 0; k < 3; ++k) g.segment<3>(3 * m_faces(f, k)) += ge.segment<3>(3 * k);
+  }
+  for (size_t h = 0; h < m_hinges.size(); ++h) {
+    const Vector12d gradient = hinge_energy_gradient(m_rest_hinges[h], hinge_corners(x, static_cast<int>(h)));
+    for (int k = 0; k < 4; ++k) g.segment<3>(3 * m_hinges[h][static_cast<size_t>(k)]) += gradient.segment<3>(3 * k);
   }
   return g;
 }
@@ -105,6 +143,14 @@ void BalloonModel::assemble_hessian(const Eigen::VectorXd& x, double pressure_mp
                                      project_membrane, m_tension_field);
     if (pressure_mpa != 0.0) hessian -= pressure_mpa * triangle_volume_hessian(c);
     assembly.add(f, hessian);
+  }
+  double hinge_energy_value;
+  Vector12d hinge_gradient;
+  Matrix12d hinge_hessian;
+  for (size_t h = 0; h < m_hinges.size(); ++h) {
+    hinge_energy_gradient_hessian(m_rest_hinges[h], hinge_corners(x, static_cast<int>(h)), hinge_energy_value,
+                                  hinge_gradient, hinge_hessian, project_membrane);
+    assembly.add_hinge(static_cast<int>(h), hinge_hessian);
   }
 }
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "fem/assembly.hpp"
+#include "fem/hinge_bending.hpp"
 #include "fem/membrane_element.hpp"
 #include "material/material.hpp"
 #include "mesh/tri_mesh.hpp"
@@ -21,6 +22,14 @@ class BalloonModel {
   void set_tension_field(bool on) { m_tension_field = on; }
   bool tension_field() const { return m_tension_field; }
 
+  /// Switches the sheet's bending stiffness on or off (off by default; see hinge_bending.hpp). An
+  /// assembly for a model with bending needs its hinges: TriangleAssembly(faces(), vertex_count(), fixed,
+  /// hinges()).
+  void set_bending(bool on);
+  bool bending() const { return m_bending; }
+  /// The bending hinges (empty while bending is off).
+  const std::vector<HingeVertices>& hinges() const { return m_hinges; }
+
   /// Replaces the rest positions (same connectivity); the design optimizer moves them.
   void set_rest_positions(const Positions& rest);
 
@@ -33,8 +42,10 @@ class BalloonModel {
 
   /// Corner positions of triangle `face` as a 9-vector.
   Vector9d corners(const Eigen::VectorXd& x, int face) const;
+  /// Positions of hinge `hinge`'s stencil as a 12-vector.
+  Vector12d hinge_corners(const Eigen::VectorXd& x, int hinge) const;
 
-  /// Elastic energy W (N*mm); +infinity when a triangle has collapsed.
+  /// Elastic energy W (N*mm): membrane, plus bending when on; +infinity when a triangle has collapsed.
   double elastic_energy(const Eigen::VectorXd& x) const;
   /// dW/dx (3#V, N).
   Eigen::VectorXd elastic_gradient(const Eigen::VectorXd& x) const;
@@ -51,7 +62,7 @@ class BalloonModel {
   int relaxed_triangle_count(const Eigen::VectorXd& x) const;
 
   /// Assembles the Hessian of W - p V (N/mm) into `assembly` (which is zeroed first).
-  /// `project_membrane` clamps each membrane block to positive semi-definite.
+  /// `project_membrane` clamps each membrane (and hinge) block to positive semi-definite.
   void assemble_hessian(const Eigen::VectorXd& x, double pressure_mpa, TriangleAssembly& assembly,
                         bool project_membrane) const;
 
@@ -63,6 +74,12 @@ class BalloonModel {
   std::vector<RestTriangle> m_rest_triangles;
   double m_rest_area = 0.0;
   bool m_tension_field = false;
+  bool m_bending = false;
+  std::vector<HingeVertices> m_hinges;
+  std::vector<RestHinge> m_rest_hinges;
+
+  /// Rest data of the hinges from the current rest positions (bending on).
+  void update_rest_hinges();
 };
 
 }  // namespace balloon::fem

@@ -44,7 +44,7 @@ const char* newton_stop_word(NewtonStop stop) {
 }
 
 EquilibriumSolver::EquilibriumSolver(fem::BalloonModel& model, const std::vector<bool>& fixed_coordinate)
-    : m_model(model), m_assembly(model.faces(), model.vertex_count(), fixed_coordinate) {
+    : m_model(model), m_assembly(model.faces(), model.vertex_count(), fixed_coordinate, model.hinges()) {
   m_solver.set_pattern(m_assembly.free_count(), m_assembly.column_starts(), m_assembly.row_indices());
   double mean_thickness = 0.0;
   for (int f = 0; f < m_model.faces().rows(); ++f) mean_thickness += m_model.thickness(f);
@@ -212,6 +212,10 @@ NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressur
     m_last_step_exact = false;
     const bool exact_factorized =
         exact_worth_trying && m_exact_fails_left == 0 && factorize_exact_for_volume(x, pressure_mpa, v);
+    if (exact_factorized) {
+      ++report.exact_factorizations;
+      if (m_solver.negative_pivots() > 0) ++report.indefinite_factorizations;
+    }
     if (exact_factorized && m_last_unstable_modes == 0 && m_solver.negative_pivots() == 0) {
       // K positive definite: the exact step descends on the augmented Lagrangian, a better guide
       // than the residual norm far from a solution.

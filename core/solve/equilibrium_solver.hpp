@@ -40,6 +40,11 @@ struct NewtonReport {
   /// Volume control: directions along which the converged state is unstable (0 = a stable
   /// equilibrium, more = a saddle such as a symmetry-breaking mode), from the last exact factorization.
   int unstable_modes = 0;
+  /// Volume control: exact factorizations of K during this solve, and how many of them were indefinite.
+  /// A solve that fails while K keeps being indefinite is creeping through wrinkles: the membrane has no
+  /// stable state there (InflationOptions::bending).
+  int exact_factorizations = 0;
+  int indefinite_factorizations = 0;
 };
 
 /// Convergence test: |r| <= relative_tolerance * F with the force scale F = |p| |grad V| + 1e-3 G h sqrt(A)

@@ -14,6 +14,9 @@ namespace balloon {
 
 enum class InflationControl { Pressure, VolumeRatio };
 
+/// Whether the membrane carries the sheet's bending stiffness (see InflationOptions::bending).
+enum class BendingUse { Off, On, Auto };
+
 struct InflationOptions {
   Material material;
   double thickness_mm = 0.5;                 ///< rest membrane thickness h (mm), uniform
@@ -30,6 +33,11 @@ struct InflationOptions {
   /// on bench_robustness it cures some shapes and slows others, because slack regions are mechanisms
   /// (zero stiffness) near zero pressure (README, "Robustness").
   bool tension_field = false;
+  /// The sheet's bending stiffness D = G h^3 / 3 as discrete-shell hinges (fem/hinge_bending.hpp): gives
+  /// compressed regions a stable folded state instead of ever finer wrinkles. `Auto` (the default)
+  /// inflates as a pure membrane and switches bending on only when a volume step fails to converge
+  /// (InflationResult::bending says whether it was on at the end).
+  BendingUse bending = BendingUse::Auto;
   /// A converged shape whose surface passes through itself (while the rest surface does not) is no
   /// physical equilibrium: the walls would touch first, and this model has no contact. Reported as
   /// InflationStop::PassesThroughItself. Costs two CGAL self-intersection tests (~10 ms per 10k faces).
@@ -66,6 +74,7 @@ struct InflationResult {
   double residual_norm = 0.0;     ///< |f_mem + f_p| over all free coordinates (N)
   int unstable_modes = 0;         ///< volume control: unstable directions of the equilibrium (0 = stable)
   int wrinkled_elements = 0;      ///< triangles the tension field relaxed at the end (wrinkled or slack); 0 when it is off
+  bool bending = false;           ///< the sheet's bending stiffness was on at the end (see InflationOptions::bending)
   int newton_iterations = 0;
   int factorizations = 0;
   int load_steps = 0;

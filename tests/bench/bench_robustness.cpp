@@ -7,8 +7,10 @@
 // the number of failures: a case fails when the solver neither converges nor says why in physical terms
 // (an equilibrium that passes through itself is such an answer: counted apart, not as a failure). --tension-field
 // switches on Pipkin's relaxation (InflationOptions::tension_field, off by default).
+// --bending on|off|auto sets InflationOptions::bending (auto by default: switched on when a volume step fails).
 // Usage: bench_robustness [DATA_DIR] [--mesh SUBSTRING]... [--material silicone|latex|neo-hookean]
-//                         [--resolution N=4000] [--max-time S=120] [--tension-field] [--quick]
+//                         [--resolution N=4000] [--max-time S=120] [--tension-field] [--bending on|off|auto]
+//                         [--quick]
 //   --quick: 200 mm as given, the largest ratio only (one case per mesh and material).
 #include <algorithm>
 #include <chrono>
@@ -66,6 +68,7 @@ int main(int argc, char** argv) {
   double max_time_s = 120.0;
   bool quick = false;
   bool tension_field = false;
+  balloon::BendingUse bending = balloon::BendingUse::Auto;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     auto value = [&]() -> std::string {
@@ -77,6 +80,10 @@ int main(int argc, char** argv) {
     };
     if (arg == "--quick") quick = true;
     else if (arg == "--tension-field") tension_field = true;
+    else if (arg == "--bending") {
+      const std::string use = value();
+      bending = use == "on" ? balloon::BendingUse::On : use == "off" ? balloon::BendingUse::Off : balloon::BendingUse::Auto;
+    }
     else if (arg == "--mesh") mesh_filters.push_back(value());
     else if (arg == "--material") material_filters.push_back(value());
     else if (arg == "--resolution") resolution = std::atoi(value().c_str());
@@ -103,8 +110,8 @@ int main(int argc, char** argv) {
 
   std::printf("volume-controlled inflation, thickness 0.5 mm, remesh above %d vertices to %d, %g s per case\n",
               resolution * 5 / 4, resolution, max_time_s);
-  std::printf("%-26s %6s %5s %6s %-12s %5s %-5s %7s %7s %8s  %s\n", "mesh", "verts", "size", "form", "material",
-              "ratio", "conv", "newton", "factors", "time_s", "message");
+  std::printf("%-26s %6s %5s %6s %-12s %5s %-5s %4s %7s %7s %8s  %s\n", "mesh", "verts", "size", "form", "material",
+              "ratio", "conv", "bend", "newton", "factors", "time_s", "message");
   std::vector<Failure> failures;
   int passes_through_itself = 0;  // converged, but the surface intersects itself: "self" in the table
   std::vector<double> times;
@@ -151,14 +158,15 @@ int main(int argc, char** argv) {
             options.volume_ratio = ratio;
             options.max_time_s = max_time_s;
             options.tension_field = tension_field;
+            options.bending = bending;
             const balloon::InflationResult result = balloon::inflate(rest, options);
             ++cases;
             times.push_back(result.time_s);
             const char* form = shrink == 1.0 ? "given" : "half";
             const bool physical_answer = result.stop == balloon::InflationStop::PassesThroughItself;
-            std::printf("%-26s %6d %5.0f %6s %-12s %5.0f %-5s %7d %7d %8.2f  %s\n", file.c_str(),
+            std::printf("%-26s %6d %5.0f %6s %-12s %5.0f %-5s %4s %7d %7d %8.2f  %s\n", file.c_str(),
                         rest.vertex_count(), size, form, m.label.c_str(), ratio,
-                        result.converged ? "yes" : physical_answer ? "self" : "NO",
+                        result.converged ? "yes" : physical_answer ? "self" : "NO", result.bending ? "on" : "off",
                         result.newton_iterations, result.factorizations, result.time_s,
                         result.converged ? "" : result.message.c_str());
             std::fflush(stdout);

@@ -325,5 +325,31 @@ TEST(Inflation, TensionFieldChangesNothingOnATautSphere) {
   EXPECT_NEAR(relaxed.pressure_kpa, plain.pressure_kpa, 1e-9 * plain.pressure_kpa);
 }
 
+TEST(Inflation, BendingKeepsTheSphereLawAndAutoLeavesItOffWhereTheMembraneConverges) {
+  // A uniform scaling keeps every dihedral angle, so the bending hinges carry (almost) nothing on a
+  // sphere: the closed-form pressure holds with bending on, for all three laws, past their maxima.
+  const TriMesh sphere = make_icosphere(10.0, 3);
+  const double radius = 3.0 * mesh_volume(sphere) / mesh_area(sphere);
+  const double h = 0.5;
+  for (const Material& material : {make(MaterialModel::NeoHookean, 0.3), make(MaterialModel::MooneyRivlin, 0.18, 0.02),
+                                   make(MaterialModel::HartSmith, 0.1, 3e-4, 1.0)}) {
+    InflationOptions options;
+    options.material = material;
+    options.thickness_mm = h;
+    options.volume_ratio = 8.0;
+    options.bending = BendingUse::On;
+    const InflationResult bent = inflate(sphere, options);
+    ASSERT_TRUE(bent.converged) << bent.message;
+    EXPECT_TRUE(bent.bending);
+    const double expected = sphere_pressure_kpa(material, h, radius, std::cbrt(bent.volume_ratio));
+    EXPECT_NEAR(bent.pressure_kpa, expected, 5e-3 * std::abs(expected));
+    options.bending = BendingUse::Auto;
+    const InflationResult automatic = inflate(sphere, options);
+    ASSERT_TRUE(automatic.converged) << automatic.message;
+    EXPECT_FALSE(automatic.bending);
+    EXPECT_NEAR(bent.pressure_kpa, automatic.pressure_kpa, 1e-3 * automatic.pressure_kpa);
+  }
+}
+
 }  // namespace
 }  // namespace balloon
