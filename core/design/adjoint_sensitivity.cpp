@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "fem/hinge_bending.hpp"
 #include "fem/membrane_element.hpp"
 
 namespace balloon {
@@ -50,6 +51,15 @@ Eigen::VectorXd AdjointSensitivity::mixed_product(const Eigen::VectorXd& rest, c
     const fem::Vector9d corners = m_model.corners(s, f);
     const fem::Vector9d product = transpose ? fem::Vector9d(mixed.transpose() * corners) : fem::Vector9d(mixed * corners);
     for (int k = 0; k < 3; ++k) out.segment<3>(3 * faces(f, k)) += product.segment<3>(3 * k);
+  }
+  // The sheet's bending hinges, when on: their rest angles and stiffnesses move with the rest shape too.
+  const auto& hinges = m_model.hinges();
+  for (int h = 0; h < static_cast<int>(hinges.size()); ++h) {
+    const fem::Matrix12d mixed =
+        fem::hinge_mixed_derivative(m_model.rest_hinge(h), m_model.hinge_corners(rest, h), m_model.hinge_corners(x, h));
+    const fem::Vector12d corners = m_model.hinge_corners(s, h);
+    const fem::Vector12d product = transpose ? fem::Vector12d(mixed.transpose() * corners) : fem::Vector12d(mixed * corners);
+    for (int k = 0; k < 4; ++k) out.segment<3>(3 * hinges[static_cast<size_t>(h)][static_cast<size_t>(k)]) += product.segment<3>(3 * k);
   }
   return out;
 }

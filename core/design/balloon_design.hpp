@@ -104,7 +104,8 @@ struct DesignResult {
   /// "fixed_rest_volume"
   /// (adjoint: the rest volume is held at target volume / ratio); "max_volume" (alm, once a rest region
   /// has turned inside out); "rest_bending" (the start has coplanar hinges); "collision" (rest vertices
-  /// came within the contact distance); "nozzle" (nozzle vertices held).
+  /// came within the contact distance); "nozzle" (nozzle vertices held); "sheet_bending" (the sheet's
+  /// bending stiffness, switched on when the start wrinkled with no stable membrane state).
   std::vector<std::string> active_terms;
   std::vector<ConvergenceSample> log;
 };

@@ -1,11 +1,13 @@
 #include "design/design_driver.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
 #include "mesh/mesh_geometry.hpp"
+#include "solve/inflation.hpp"
 #include "solve/rigid_modes.hpp"
 
 namespace balloon {
@@ -90,7 +92,7 @@ bool DesignDriver::inflate_start(const Eigen::VectorXd& rest, DesignResult& resu
   // pressure.
   m_x = flat(scaled_about_centroid(m_rest_mesh.vertices, std::cbrt(m_target_volume / rest_volume(rest))));
   m_pressure = 0.0;
-  if (!inflate_by_volume_steps(rest, result)) return false;
+  if (!inflate_start_to_target_volume(rest, result)) return false;
   debug_time("initial inflation");
   const SurfaceDistanceStats baseline = m_objective.surface().aligned_stats(unflatten(m_x), m_target.vertices);
   result.baseline_avg_error_mm = baseline.avg_mm;
@@ -101,40 +103,49 @@ bool DesignDriver::inflate_start(const Eigen::VectorXd& rest, DesignResult& resu
   return true;
 }
 
-bool DesignDriver::inflate_by_volume_steps(const Eigen::VectorXd& rest, DesignResult& result) {
+bool DesignDriver::inflate_start_to_target_volume(const Eigen::VectorXd& rest, DesignResult& result) {
   m_model.set_rest_positions(unflatten(rest));
-  const double start_volume = rest_volume(rest);
-  double reached = start_volume;
-  Eigen::VectorXd x = rest;
-  double pressure = 0.0;
-  double step = m_target_volume - start_volume;
-  while (reached < m_target_volume) {
-    const double next = std::min(m_target_volume, reached + step);
-    Eigen::VectorXd trial = flat(scaled_about_centroid(unflatten(x), std::cbrt(next / enclosed_volume(unflatten(x), m_target.faces))));
-    double trial_pressure = pressure;
-    if (trial_pressure == 0.0) {
-      const Eigen::VectorXd g = m_solver.residual(trial, 0.0);
-      Eigen::VectorXd v = m_model.volume_gradient(trial);
-      trial_pressure = g.dot(v) / v.squaredNorm();
-    }
-    m_last_report = m_solver.solve_volume(trial, trial_pressure, next, m_settings);
-    if (m_last_report.converged) {
-      x = trial;
-      pressure = trial_pressure;
-      reached = next;
-      continue;
-    }
-    if (stopped()) {
-      stop_with(result, m_last_report.message == "cancelled" ? DesignStop::Cancelled : DesignStop::TimeLimit,
-                m_last_report.message + " while inflating the start");
-      return false;
-    }
-    if (step < 1e-3 * (m_target_volume - start_volume)) {
-      stop_with(result, DesignStop::StartFailed,
-                "the start shape could not be inflated to the target volume (" + m_last_report.message + ")");
-      return false;
-    }
-    step *= 0.5;
+  // The forward solver's own volume path (step control, resumed creeping steps, and the sheet's bending
+  // where the membrane alone wrinkles with no stable state), on the same rigid support as this driver's
+  // solver, to the design's tolerance.
+  InflationOptions inflation;
+  inflation.material = m_model.material();
+  inflation.element_thickness_mm.resize(static_cast<size_t>(m_model.faces().rows()));
+  for (int f = 0; f < m_model.faces().rows(); ++f) inflation.element_thickness_mm[static_cast<size_t>(f)] = m_model.thickness(f);
+  inflation.control = InflationControl::VolumeRatio;
+  inflation.volume_ratio = m_target_volume / rest_volume(rest);
+  inflation.residual_tolerance = m_settings.relative_tolerance;
+  inflation.reject_self_intersection = false;  // the design moves the shape away from itself
+  // The augmented Lagrangian assembles membrane-only derivatives: no bending there.
+  inflation.bending = m_options.method == DesignMethod::Adjoint ? BendingUse::Auto : BendingUse::Off;
+  inflation.cancel = m_options.cancel;
+  if (m_settings.deadline_s > 0) inflation.max_time_s = std::max(1e-3, m_settings.deadline_s - design_clock_s());
+  const TriMesh rest_mesh{unflatten(rest), m_model.faces()};
+  const InflationResult inflated = inflate(rest_mesh, inflation);
+  if (!inflated.converged) {
+    m_last_report.message = inflated.message;
+    const bool cancelled = inflated.stop == InflationStop::Cancelled;
+    if (cancelled || inflated.stop == InflationStop::TimeLimit)
+      stop_with(result, cancelled ? DesignStop::Cancelled : DesignStop::TimeLimit,
+                inflated.message + " while inflating the start");
+    else
+      stop_with(result, DesignStop::StartFailed, "the start shape could not be inflated to the target volume (" +
+                                                     inflated.message + ")");
+    return false;
+  }
+  if (inflated.bending) {
+    m_model.set_bending(true);
+    m_solver.refresh_pattern();
+    result.active_terms.push_back("sheet_bending");
+  }
+  // Settle on this driver's solver (its pinned coordinates hold the values the equilibrium has).
+  Eigen::VectorXd x = flat(inflated.deformed);
+  double pressure = inflated.pressure_kpa * MPA_PER_KPA;
+  m_last_report = m_solver.solve_volume(x, pressure, m_target_volume, m_settings);
+  if (!m_last_report.converged) {
+    stop_with(result, stopped() ? DesignStop::TimeLimit : DesignStop::StartFailed,
+              "the inflated start did not settle on the design's support (" + m_last_report.message + ")");
+    return false;
   }
   // Place the inflated start on the target (a rigid motion of an equilibrium is one): the pinned
   // coordinates then hold it in the target's frame, where E_surf and the errors are measured. A

@@ -87,8 +87,10 @@ class DesignDriver {
   void debug_time(const char* what) const;
 
  private:
-  /// The start's inflation from x to the target's volume, by volume steps when one step is too far.
-  bool inflate_by_volume_steps(const Eigen::VectorXd& rest, DesignResult& result);
+  /// The start's inflation to the target's volume by the forward solver's volume path (solve/inflation).
+  /// Where that needed the sheet's bending stiffness, the design keeps it on (adjoint method; listed as
+  /// the active term "sheet_bending").
+  bool inflate_start_to_target_volume(const Eigen::VectorXd& rest, DesignResult& result);
 
   const TriMesh& m_target;
   const DesignOptions& m_options;

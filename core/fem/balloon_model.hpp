@@ -29,6 +29,8 @@ class BalloonModel {
   bool bending() const { return m_bending; }
   /// The bending hinges (empty while bending is off).
   const std::vector<HingeVertices>& hinges() const { return m_hinges; }
+  /// Rest data of hinge `hinge` (bending on).
+  const RestHinge& rest_hinge(int hinge) const { return m_rest_hinges[static_cast<size_t>(hinge)]; }
 
   /// Replaces the rest positions (same connectivity); the design optimizer moves them.
   void set_rest_positions(const Positions& rest);

@@ -35,6 +35,18 @@ Eigen::Matrix<T, 12, 1> dihedral_angle_gradient(const Eigen::Matrix<T, 12, 1>& x
   return g;
 }
 
+/// |e|^2 / (A_a + A_b) of a rest stencil (dimensionless), k = (3 D / 4) times it.
+template <typename T>
+T strip_weight(const Eigen::Matrix<T, 12, 1>& x) {
+  using Vector3 = Eigen::Matrix<T, 3, 1>;
+  using std::sqrt;
+  const Vector3 x0 = x.template segment<3>(0), x1 = x.template segment<3>(3), x2 = x.template segment<3>(6),
+                x3 = x.template segment<3>(9);
+  const Vector3 edge = x1 - x0;
+  const T area = 0.5 * (sqrt(edge.cross(x2 - x0).squaredNorm()) + sqrt((x0 - x1).cross(x3 - x1).squaredNorm()));
+  return edge.squaredNorm() / area;
+}
+
 /// theta - theta_rest in (-pi, pi]: a hinge that folds through a flat-back state keeps its meaning.
 double bend_angle(double theta, double rest_angle) { return std::remainder(theta - rest_angle, 2.0 * M_PI); }
 
@@ -75,15 +87,12 @@ double dihedral_angle(const Vector12d& x) {
 }
 
 RestHinge make_rest_hinge(const Vector12d& rest, double bending_modulus_nmm) {
-  const Eigen::Vector3d x0 = rest.segment<3>(0), x1 = rest.segment<3>(3);
-  const Eigen::Vector3d edge = x1 - x0;
-  const double area_a = 0.5 * edge.cross(Eigen::Vector3d(rest.segment<3>(6)) - x0).norm();
-  const double area_b = 0.5 * (x0 - x1).cross(Eigen::Vector3d(rest.segment<3>(9)) - x1).norm();
   RestHinge hinge;
+  hinge.modulus = bending_modulus_nmm;
   hinge.rest_angle = dihedral_angle(rest);
   // A sliver pair of no area would make k unbounded: such a hinge carries no bending.
-  const double area = area_a + area_b;
-  hinge.stiffness = area > 0.0 && std::isfinite(hinge.rest_angle) ? 0.75 * bending_modulus_nmm * edge.squaredNorm() / area : 0.0;
+  const double weight = strip_weight(rest);
+  hinge.stiffness = std::isfinite(weight) && std::isfinite(hinge.rest_angle) ? 0.75 * bending_modulus_nmm * weight : 0.0;
   return hinge;
 }
 
@@ -113,6 +122,19 @@ void hinge_energy_gradient_hessian(const RestHinge& rest, const Vector12d& x, do
 Vector12d hinge_energy_gradient(const RestHinge& rest, const Vector12d& x) {
   const double bend = bend_angle(dihedral_angle(x), rest.rest_angle);
   return 2.0 * rest.stiffness * bend * dihedral_angle_gradient(x);
+}
+
+Matrix12d hinge_mixed_derivative(const RestHinge& rest_hinge, const Vector12d& rest, const Vector12d& x) {
+  // gradient_x = 2 k(X) (theta(x) - theta_rest(X)) grad theta(x), so its derivative in X is
+  // 2 grad theta(x) [(theta - theta_rest) grad k(X) - k grad theta_rest(X)]^T.
+  if (rest_hinge.stiffness == 0.0) return Matrix12d::Zero();
+  const double bend = bend_angle(dihedral_angle(x), rest_hinge.rest_angle);
+  using Dual = Eigen::AutoDiffScalar<Vector12d>;
+  Eigen::Matrix<Dual, 12, 1> dual_rest;
+  for (int i = 0; i < 12; ++i) dual_rest[i] = Dual(rest[i], 12, i);
+  const Vector12d stiffness_gradient = 0.75 * rest_hinge.modulus * strip_weight(dual_rest).derivatives();
+  const Vector12d rest_term = bend * stiffness_gradient - rest_hinge.stiffness * dihedral_angle_gradient(rest);
+  return 2.0 * dihedral_angle_gradient(x) * rest_term.transpose();
 }
 
 }  // namespace balloon::fem

@@ -32,6 +32,7 @@ std::vector<HingeVertices> mesh_hinges(const Faces& faces);
 struct RestHinge {
   double stiffness = 0.0;   ///< k (N*mm per rad^2)
   double rest_angle = 0.0;  ///< theta_rest (rad)
+  double modulus = 0.0;     ///< the sheet's bending modulus D (N*mm) it was made with
 };
 
 /// Rest data from the rest stencil and the sheet's bending modulus D (N*mm).
@@ -55,5 +56,9 @@ Vector12d hinge_energy_gradient(const RestHinge& rest, const Vector12d& x);
 /// Gauss-Newton part 2 k grad(theta) grad(theta)^T, positive semi-definite; otherwise exact.
 void hinge_energy_gradient_hessian(const RestHinge& rest, const Vector12d& x, double& energy, Vector12d& gradient,
                                    Matrix12d& hessian, bool project_to_psd = false);
+
+/// Mixed derivative d(gradient_x)/d(rest) (12x12, N/mm) of the hinge energy: row i a deformed
+/// coordinate, column j a rest coordinate (both theta_rest and k move with the rest shape).
+Matrix12d hinge_mixed_derivative(const RestHinge& rest_hinge, const Vector12d& rest, const Vector12d& x);
 
 }  // namespace balloon::fem

@@ -53,6 +53,20 @@ EquilibriumSolver::EquilibriumSolver(fem::BalloonModel& model, const std::vector
   m_force_floor = 1e-3 * m_model.material().shear_modulus() * mean_thickness * std::sqrt(m_model.rest_area());
 }
 
+void EquilibriumSolver::refresh_pattern() {
+  std::vector<bool> fixed(static_cast<size_t>(3 * m_model.vertex_count()));
+  for (int c = 0; c < 3 * m_model.vertex_count(); ++c) fixed[static_cast<size_t>(c)] = m_assembly.free_index(c) < 0;
+  m_assembly = fem::TriangleAssembly(m_model.faces(), m_model.vertex_count(), fixed, m_model.hinges());
+  m_solver.set_pattern(m_assembly.free_count(), m_assembly.column_starts(), m_assembly.row_indices());
+  m_skip_ldlt = 0;
+  m_exact_fails_left = 0;
+  m_last_unstable_modes = 0;
+  m_sqp_shift = 0.0;
+  m_sqp_unshifted_steps = 0;
+  m_last_step_exact = false;
+  m_exact_indefinite = false;
+}
+
 Eigen::VectorXd EquilibriumSolver::residual(const Eigen::VectorXd& x, double pressure_mpa) const {
   Eigen::VectorXd r = m_model.elastic_gradient(x) - pressure_mpa * m_model.volume_gradient(x);
   for (int c = 0; c < r.size(); ++c)

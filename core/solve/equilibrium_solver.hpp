@@ -89,6 +89,10 @@ class EquilibriumSolver {
 
   int factorizations() const { return m_solver.factorizations(); }
 
+  /// Rebuilds the sparsity pattern and forgets the step history after the model's hinges changed
+  /// (BalloonModel::set_bending): the same fixed coordinates, a new symbolic analysis.
+  void refresh_pattern();
+
  private:
   /// Factorizes K, or K + shift I with the smallest shift found that makes it positive definite.
   bool factorize_stiffness(const Eigen::VectorXd& x, double pressure_mpa);

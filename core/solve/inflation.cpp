@@ -72,7 +72,7 @@ class InflationRun {
         m_options(options),
         m_model(make_model(rest, options)),
         m_fixed(fixed_coordinates(rest, options)),
-        m_solver(std::make_unique<EquilibriumSolver>(m_model, m_fixed)),
+        m_solver(m_model, m_fixed),
         m_start(now_s()) {
     m_settings.relative_tolerance = options.residual_tolerance;
     m_settings.max_iterations = 60;
@@ -133,7 +133,7 @@ class InflationRun {
   /// stiffness K = Hess(W - p V) over the free coordinates (0 when K is positive definite). One
   /// supernodal LL^T; the LDL^T for the inertia only when that fails. -1 when K is singular.
   int pressure_unstable_modes() {
-    if (m_solver->factorize_at(m_state.x, m_state.pressure)) return 0;
+    if (m_solver.factorize_at(m_state.x, m_state.pressure)) return 0;
     if (!m_inertia) m_inertia = std::make_unique<Inertia>(m_model, m_fixed);
     return m_inertia->negative_eigenvalues(m_model, m_state.x, m_state.pressure);
   }
@@ -166,7 +166,7 @@ class InflationRun {
 
   /// Least-squares pressure for a shape: the p minimising |grad W - p grad V|.
   double estimate_pressure(const Eigen::VectorXd& x) const {
-    const auto& assembly = m_solver->assembly();
+    const auto& assembly = m_solver.assembly();
     const Eigen::VectorXd g = assembly.restrict(m_model.elastic_gradient(x));
     const Eigen::VectorXd v = assembly.restrict(m_model.volume_gradient(x));
     const double vv = v.squaredNorm();
@@ -237,8 +237,8 @@ class InflationRun {
       pressure = estimate_pressure(x);
     }
     if (pressure == 0.0) pressure = estimate_pressure(x);
-    m_unfinished_start_residual = m_solver->residual(x, pressure).norm();
-    report = m_solver->solve_volume(x, pressure, target_volume, m_settings);
+    m_unfinished_start_residual = m_solver.residual(x, pressure).norm();
+    report = m_solver.solve_volume(x, pressure, target_volume, m_settings);
     m_newton_iterations += report.iterations;
     if (!report.converged) {
       m_unfinished = {x, pressure, target_volume};
@@ -300,7 +300,7 @@ class InflationRun {
       if (std::abs(step) < smallest) {
         message = "no equilibrium found at volume ratio " + format_number(next / m_model.volume(flat_rest())) +
                   " (" + report.message + ", residual " + format_number(report.residual_norm) + " N against a tolerance of " +
-                  format_number(m_settings.relative_tolerance * m_solver->force_scale(state.x, state.pressure)) + " N)";
+                  format_number(m_settings.relative_tolerance * m_solver.force_scale(state.x, state.pressure)) + " N)";
         return false;
       }
     }
@@ -314,12 +314,11 @@ class InflationRun {
   }
 
   /// Under BendingUse::Auto, a volume step that failed as a pure membrane switches the sheet's bending
-  /// stiffness on for the rest of the path (a new solver: the hinges widen the pattern). True if it did.
+  /// stiffness on for the rest of the path (the hinges widen the solver's pattern). True if it did.
   bool switch_bending_on() {
     if (m_options.bending != BendingUse::Auto || m_model.bending()) return false;
     m_model.set_bending(true);
-    m_earlier_factorizations += m_solver->factorizations();
-    m_solver = std::make_unique<EquilibriumSolver>(m_model, m_fixed);
+    m_solver.refresh_pattern();
     m_inertia.reset();
     return true;
   }
@@ -369,7 +368,7 @@ class InflationRun {
         // Bracketed: interpolate between the two path points, then solve at the exact pressure.
         const double theta = (target_pressure - previous.pressure) / (state.pressure - previous.pressure);
         Eigen::VectorXd x = previous.x + theta * (state.x - previous.x);
-        report = m_solver->solve_pressure(x, target_pressure, m_settings);
+        report = m_solver.solve_pressure(x, target_pressure, m_settings);
         m_newton_iterations += report.iterations;
         if (!report.converged) {
           message = "no equilibrium found at " + format_kpa(target_pressure) + " (" + report.message + ", residual " +
@@ -401,7 +400,7 @@ class InflationRun {
     result.unstable_modes = m_unstable_modes;
     result.wrinkled_elements = m_model.tension_field() ? m_model.relaxed_triangle_count(state.x) : 0;
     result.newton_iterations = m_newton_iterations;
-    result.factorizations = m_earlier_factorizations + m_solver->factorizations();
+    result.factorizations = m_solver.factorizations();
     result.bending = m_model.bending();
     result.load_steps = m_load_steps;
     result.time_s = now_s() - m_start;
@@ -411,8 +410,7 @@ class InflationRun {
   const InflationOptions& m_options;
   fem::BalloonModel m_model;
   std::vector<bool> m_fixed;
-  std::unique_ptr<EquilibriumSolver> m_solver;  ///< rebuilt when bending is switched on (a wider pattern)
-  int m_earlier_factorizations = 0;             ///< by solvers replaced before m_solver
+  EquilibriumSolver m_solver;
   NewtonSettings m_settings;
   double m_start;
   int m_newton_iterations = 0;

@@ -1,7 +1,7 @@
 #pragma once
 /// The design's sensitivity scene for finite-difference tests: an asymmetric balloon (42-vertex ellipsoid,
 /// semi-axes 14, 10, 8 mm) inflated 3-fold under volume control, with the model and solver the design
-/// uses, and equilibria of perturbed rest shapes solved tightly from it.
+/// uses, and equilibria of perturbed rest shapes solved tightly from it; optionally with bending on.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -52,13 +52,23 @@ struct Scene {
     return fixed;
   }
 
-  Scene()
+  static fem::BalloonModel make_model(const TriMesh& rest, const Material& material, double thickness_mm,
+                                      bool bending) {
+    fem::BalloonModel model(rest, material, std::vector<double>(static_cast<size_t>(rest.face_count()), thickness_mm));
+    model.set_bending(bending);
+    return model;
+  }
+
+  /// `bending`: the sheet's bending hinges on (a thick sheet, so that they matter).
+  explicit Scene(bool bending = false)
       : rest(ellipsoid()),
-        model(rest, material, std::vector<double>(static_cast<size_t>(rest.face_count()), 0.5)),
+        model(make_model(rest, material, bending ? 2.0 : 0.5, bending)),
         fixed(support(rest)),
         solver(model, fixed) {
     InflationOptions inflation;
     inflation.material = material;
+    inflation.thickness_mm = bending ? 2.0 : 0.5;
+    inflation.bending = bending ? BendingUse::On : BendingUse::Off;
     inflation.volume_ratio = 3.0;
     const InflationResult inflated = inflate(rest, inflation);
     EXPECT_TRUE(inflated.converged) << inflated.message;

@@ -10,8 +10,10 @@ namespace {
 using design_test::flat;
 using design_test::Scene;
 
-TEST(AdjointSensitivity, DesignGradientMatchesCentralDifferences) {
-  Scene scene;
+class AdjointSensitivityTest : public ::testing::TestWithParam<bool> {};
+
+TEST_P(AdjointSensitivityTest, DesignGradientMatchesCentralDifferences) {
+  Scene scene(GetParam());
   const Eigen::VectorXd rest = flat(scene.rest.vertices);
   // J(x) = 1/2 |x - x_goal|^2, x_goal a fixed displacement of the equilibrium (mm^2).
   const Eigen::VectorXd goal = scene.x + 0.5 * scene.direction(11);
@@ -35,8 +37,8 @@ TEST(AdjointSensitivity, DesignGradientMatchesCentralDifferences) {
   }
 }
 
-TEST(AdjointSensitivity, LinearResponseMatchesCentralDifferences) {
-  Scene scene;
+TEST_P(AdjointSensitivityTest, LinearResponseMatchesCentralDifferences) {
+  Scene scene(GetParam());
   const Eigen::VectorXd rest = flat(scene.rest.vertices);
   scene.model.set_rest_positions(scene.rest.vertices);
   AdjointSensitivity sensitivity(scene.model, scene.solver);
@@ -55,6 +57,9 @@ TEST(AdjointSensitivity, LinearResponseMatchesCentralDifferences) {
   EXPECT_LT((dx - dx_fd).norm(), 1e-5 * dx_fd.norm()) << "|dx| " << dx.norm() << ", |dx_fd| " << dx_fd.norm();
   EXPECT_NEAR(dp, (p_plus - p_minus) / (2.0 * STEP_MM), 1e-5 * std::abs(dp) + 1e-12);
 }
+
+INSTANTIATE_TEST_SUITE_P(MembraneAndBending, AdjointSensitivityTest, ::testing::Bool(),
+                         [](const auto& info) { return info.param ? "WithBending" : "MembraneOnly"; });
 
 }  // namespace
 }  // namespace balloon

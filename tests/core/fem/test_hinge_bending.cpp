@@ -66,6 +66,31 @@ TEST(HingeBending, GradientAndHessianMatchCentralDifferences) {
   }
 }
 
+TEST(HingeBending, MixedRestDerivativeMatchesCentralDifferences) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (const double fold : {0.0, 0.3, -0.6}) {
+    Vector12d rest = tent(0.1), x = tent(fold);
+    for (int i = 0; i < 12; ++i) {
+      rest[i] += 0.05 * u(rng);
+      x[i] += 0.05 * u(rng);
+    }
+    const double modulus = 0.02;
+    const Matrix12d mixed = hinge_mixed_derivative(make_rest_hinge(rest, modulus), rest, x);
+    Matrix12d fd;
+    const double h = 1e-6;
+    for (int j = 0; j < 12; ++j) {
+      Vector12d plus = rest, minus = rest;
+      plus[j] += h;
+      minus[j] -= h;
+      fd.col(j) = (hinge_energy_gradient(make_rest_hinge(plus, modulus), x) -
+                   hinge_energy_gradient(make_rest_hinge(minus, modulus), x)) / (2 * h);
+    }
+    EXPECT_LT((mixed - fd).norm(), 1e-6 * mixed.norm()) << "fold " << fold;
+    EXPECT_GT(mixed.norm(), 0.0);
+  }
+}
+
 TEST(HingeBending, StiffnessIsTheSheetsBendingModulusOverAStrip) {
   // k = (3 D / 4) |e|^2 / (A_a + A_b), D = G h^3 / 3.
   const double modulus = bending_modulus(0.3, 0.5);
