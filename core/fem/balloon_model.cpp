@@ -34,24 +34,26 @@ void BalloonModel::set_rest_positions(const Positions& rest) {
 void BalloonModel::set_bending(bool on) {
   m_bending = on;
   m_hinges = on ? mesh_hinges(m_faces) : std::vector<HingeVertices>{};
-  if (on) update_rest_hinges();
-  else m_rest_hinges.clear();
-}
-
-void BalloonModel::update_rest_hinges() {
-  // Per hinge, the bending modulus of the mean thickness of its two triangles; the small-strain G.
+  m_hinge_modulus.clear();
+  m_rest_hinges.clear();
+  if (!on) return;
+  // Per hinge, the bending modulus of the mean thickness of its two triangles, with the small-strain G.
   std::map<std::pair<int, int>, int> face_of_edge;
   for (int f = 0; f < m_faces.rows(); ++f)
     for (int k = 0; k < 3; ++k) face_of_edge[{m_faces(f, k), m_faces(f, (k + 1) % 3)}] = f;
-  const Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(m_rest.data(), m_rest.size());
-  m_rest_hinges.resize(m_hinges.size());
-  for (size_t h = 0; h < m_hinges.size(); ++h) {
-    const auto& v = m_hinges[h];
+  for (const auto& v : m_hinges) {
     const double thickness = 0.5 * (m_thickness[static_cast<size_t>(face_of_edge.at({v[0], v[1]}))] +
                                     m_thickness[static_cast<size_t>(face_of_edge.at({v[1], v[0]}))]);
-    m_rest_hinges[h] = make_rest_hinge(hinge_corners(x, static_cast<int>(h)),
-                                       bending_modulus(m_material.shear_modulus(), thickness));
+    m_hinge_modulus.push_back(bending_modulus(m_material.shear_modulus(), thickness));
   }
+  update_rest_hinges();
+}
+
+void BalloonModel::update_rest_hinges() {
+  const Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(m_rest.data(), m_rest.size());
+  m_rest_hinges.resize(m_hinges.size());
+  for (size_t h = 0; h < m_hinges.size(); ++h)
+    m_rest_hinges[h] = make_rest_hinge(hinge_corners(x, static_cast<int>(h)), m_hinge_modulus[h]);
 }
 
 Vector12d BalloonModel::hinge_corners(const Eigen::VectorXd& x, int hinge) const {

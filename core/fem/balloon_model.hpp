@@ -79,6 +79,7 @@ class BalloonModel {
   bool m_bending = false;
   std::vector<HingeVertices> m_hinges;
   std::vector<RestHinge> m_rest_hinges;
+  std::vector<double> m_hinge_modulus;  ///< D of each hinge (N*mm), fixed with the thickness
 
   /// Rest data of the hinges from the current rest positions (bending on).
   void update_rest_hinges();
