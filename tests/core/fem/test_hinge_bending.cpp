@@ -24,6 +24,14 @@ Vector12d tent(double fold, double wing = 1.0) {
   return x;
 }
 
+/// A Neo-Hookean (mu = 0.3 MPa) balloon of `mesh` with a uniform thickness.
+BalloonModel neo_hookean_balloon(const TriMesh& mesh, double thickness_mm) {
+  Material rubber;
+  rubber.model = MaterialModel::NeoHookean;
+  rubber.params = {0.3, 0, 0};
+  return BalloonModel(mesh, rubber, std::vector<double>(static_cast<size_t>(mesh.face_count()), thickness_mm));
+}
+
 TEST(HingeBending, DihedralAngleIsZeroWhenFlatAndPositiveWhenConvex) {
   EXPECT_NEAR(dihedral_angle(tent(0.0)), 0.0, 1e-15);
   // Each wing tilted down by `fold`: the normals are 2 fold apart; a convex fold, as on a sphere.
@@ -108,10 +116,7 @@ TEST(HingeBending, EveryInteriorEdgeOfAClosedMeshIsOneHinge) {
 
 TEST(HingeBending, AUniformlyScaledSphereStoresNoBendingEnergy) {
   const TriMesh sphere = make_icosphere(10.0, 2);
-  Material rubber;
-  rubber.model = MaterialModel::NeoHookean;
-  rubber.params = {0.3, 0, 0};
-  BalloonModel model(sphere, rubber, std::vector<double>(static_cast<size_t>(sphere.face_count()), 0.5));
+  BalloonModel model = neo_hookean_balloon(sphere, 0.5);
   const Eigen::VectorXd rest = Eigen::Map<const Eigen::VectorXd>(sphere.vertices.data(), sphere.vertices.size());
   const Eigen::VectorXd inflated = 1.7 * rest;
   const double membrane_only = model.elastic_energy(inflated);
@@ -123,10 +128,7 @@ TEST(HingeBending, AUniformlyScaledSphereStoresNoBendingEnergy) {
 
 TEST(HingeBending, AssembledHessianWithHingesMatchesDifferencesOfTheModelGradient) {
   const TriMesh sphere = make_icosphere(10.0, 1);
-  Material rubber;
-  rubber.model = MaterialModel::NeoHookean;
-  rubber.params = {0.3, 0, 0};
-  BalloonModel model(sphere, rubber, std::vector<double>(static_cast<size_t>(sphere.face_count()), 2.0));
+  BalloonModel model = neo_hookean_balloon(sphere, 2.0);
   model.set_bending(true);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
