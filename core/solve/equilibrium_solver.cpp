@@ -181,6 +181,7 @@ NewtonReport EquilibriumSolver::solve_pressure(Eigen::VectorXd& x, double pressu
 NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
                                              const NewtonSettings& settings) {
   NewtonReport report;
+  m_shift_restart = settings.shift_restart;
   const double volume_tolerance = settings.relative_tolerance * std::abs(target_volume);
   auto merit = [&](const Eigen::VectorXd& y, double p, double force_tolerance) {
     const double rn = m_assembly.restrict(residual(y, p)).norm();
@@ -317,9 +318,7 @@ bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, doubl
   if (!factorized && m_solver.factorize_ldlt(m_assembly.values()) == SparseSolver::Status::Ok &&
       kkt_negative_eigenvalues(v) == 1)
     factorized = true;
-  // The last shift halved: a quarter let the shift cycle a decade above what the model needs (0.03 ->
-  // 0.0075, too small -> 0.075), and so the steps a decade too short, on the knot and the femur.
-  if (!factorized) shift = std::max(0.5 * m_sqp_shift, 1e-6 * base);
+  if (!factorized) shift = std::max(m_shift_restart * m_sqp_shift, 1e-6 * base);
   while (!factorized) {
     if (shift > 1e8 * base) return false;
     factorized = m_solver.factorize_llt(m_assembly.values(), shift) == SparseSolver::Status::Ok;

@@ -56,6 +56,13 @@ struct NewtonSettings {
   int max_iterations = 30;
   const CancelToken* cancel = nullptr;
   double deadline_s = 0.0;  ///< absolute time (steady clock seconds) after which to stop; 0 = none
+  /// Volume control: a shifted SQP step starts its search for the Levenberg shift from this fraction of
+  /// the last one (then x10 until the model is positive definite). A long path through snap-throughs
+  /// and wrinkling (inflate()) restarts from 1/2: from 1/4 the shift cycled a decade above what the
+  /// model needed and cut every step short (knot, femur). The design keeps 1/4, for its start too: its
+  /// result depends on which of two equally converged starts it gets (spot with latex past its pressure
+  /// maximum: 8.7x the baseline from the start solved with 1/4, 1.9x from the one solved with 1/2).
+  double shift_restart = 0.25;
 };
 
 class EquilibriumSolver {
@@ -120,6 +127,7 @@ class EquilibriumSolver {
   int m_exact_fails_left = 0;
   int m_last_unstable_modes = 0;
   double m_sqp_shift = 0.0;        ///< Levenberg shift of the last SQP step (N/mm)
+  double m_shift_restart = 0.25;   ///< NewtonSettings::shift_restart of the current solve
   int m_sqp_unshifted_steps = 0;        ///< consecutive unshifted SQP steps: close enough for the exact step
   bool m_last_step_exact = false;  ///< the last volume step was the exact one
   bool m_exact_indefinite = false;  ///< the last exact stiffness had negative pivots: skip the LL^T attempt
