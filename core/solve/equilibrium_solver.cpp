@@ -181,7 +181,6 @@ NewtonReport EquilibriumSolver::solve_pressure(Eigen::VectorXd& x, double pressu
 NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
                                              const NewtonSettings& settings) {
   NewtonReport report;
-  m_shift_restart = settings.shift_restart;
   const double volume_tolerance = settings.relative_tolerance * std::abs(target_volume);
   auto merit = [&](const Eigen::VectorXd& y, double p, double force_tolerance) {
     const double rn = m_assembly.restrict(residual(y, p)).norm();
@@ -269,7 +268,7 @@ NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressur
 
     // Robust path (wrinkling, snap-through, past limit points, far from a solution): an SQP step on a
     // positive definite model of the Hessian, which descends towards a constrained minimum of W.
-    if (!sqp_step(x, pressure_mpa, target_volume, v, r, c)) {
+    if (!sqp_step(x, pressure_mpa, target_volume, v, r, c, settings.shift_restart)) {
       report.stop = NewtonStop::LineSearchFailed;
       report.message = "line search failed";
       return report;
@@ -306,7 +305,7 @@ int EquilibriumSolver::kkt_negative_eigenvalues(const Eigen::VectorXd& v) const 
 }
 
 bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
-                                 const Eigen::VectorXd& v, const Eigen::VectorXd& r, double c) {
+                                 const Eigen::VectorXd& v, const Eigen::VectorXd& r, double c, double shift_restart) {
   m_model.assemble_hessian(x, pressure_mpa, m_assembly, true);
   const double base = std::max(1e-30, m_assembly.mean_abs_diagonal());
   // The model H (projected membrane blocks, exact pressure term) is used unshifted when the KKT matrix
@@ -318,7 +317,7 @@ bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, doubl
   if (!factorized && m_solver.factorize_ldlt(m_assembly.values()) == SparseSolver::Status::Ok &&
       kkt_negative_eigenvalues(v) == 1)
     factorized = true;
-  if (!factorized) shift = std::max(m_shift_restart * m_sqp_shift, 1e-6 * base);
+  if (!factorized) shift = std::max(shift_restart * m_sqp_shift, 1e-6 * base);
   while (!factorized) {
     if (shift > 1e8 * base) return false;
     factorized = m_solver.factorize_llt(m_assembly.values(), shift) == SparseSolver::Status::Ok;

@@ -109,8 +109,9 @@ class EquilibriumSolver {
   int kkt_negative_eigenvalues(const Eigen::VectorXd& v) const;
   /// One SQP step for volume control with a positive definite model of the Hessian (projected membrane
   /// blocks plus a Levenberg shift), globalised on the augmented Lagrangian at the new multiplier.
+  /// `shift_restart` is NewtonSettings::shift_restart.
   bool sqp_step(Eigen::VectorXd& x, double& pressure_mpa, double target_volume, const Eigen::VectorXd& v,
-                const Eigen::VectorXd& r, double c);
+                const Eigen::VectorXd& r, double c, double shift_restart);
   /// KKT step of the factorized positive definite Hessian (model), line-searched on the augmented
   /// Lagrangian at the new multiplier or on a clear fall of the KKT residual. False if no step helped.
   bool constrained_descent(Eigen::VectorXd& x, double& pressure_mpa, double target_volume, const Eigen::VectorXd& v,
@@ -127,7 +128,6 @@ class EquilibriumSolver {
   int m_exact_fails_left = 0;
   int m_last_unstable_modes = 0;
   double m_sqp_shift = 0.0;        ///< Levenberg shift of the last SQP step (N/mm)
-  double m_shift_restart = 0.25;   ///< NewtonSettings::shift_restart of the current solve
   int m_sqp_unshifted_steps = 0;        ///< consecutive unshifted SQP steps: close enough for the exact step
   bool m_last_step_exact = false;  ///< the last volume step was the exact one
   bool m_exact_indefinite = false;  ///< the last exact stiffness had negative pivots: skip the LL^T attempt
