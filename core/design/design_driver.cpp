@@ -88,10 +88,6 @@ DesignResult DesignDriver::begin(DesignMethod method) const {
 }
 
 bool DesignDriver::inflate_start(const Eigen::VectorXd& rest, DesignResult& result) {
-  // The start's guess: the rest shape blown up to the target's volume; the start inflation fixes the
-  // pressure.
-  m_x = flat(scaled_about_centroid(m_rest_mesh.vertices, std::cbrt(m_target_volume / rest_volume(rest))));
-  m_pressure = 0.0;
   if (!inflate_start_to_target_volume(rest, result)) return false;
   debug_time("initial inflation");
   const SurfaceDistanceStats baseline = m_objective.surface().aligned_stats(unflatten(m_x), m_target.vertices);

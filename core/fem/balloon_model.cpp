@@ -1,9 +1,8 @@
 #include "fem/balloon_model.hpp"
 
+#include <array>
 #include <cmath>
 #include <limits>
-#include <map>
-#include <utility>
 #include <stdexcept>
 
 #include "fem/pressure_load.hpp"
@@ -33,17 +32,14 @@ void BalloonModel::set_rest_positions(const Positions& rest) {
 
 void BalloonModel::set_bending(bool on) {
   m_bending = on;
-  m_hinges = on ? mesh_hinges(m_faces) : std::vector<HingeVertices>{};
+  std::vector<std::array<int, 2>> hinge_faces;
+  m_hinges = on ? mesh_hinges(m_faces, &hinge_faces) : std::vector<HingeVertices>{};
   m_hinge_modulus.clear();
   m_rest_hinges.clear();
   if (!on) return;
   // Per hinge, the bending modulus of the mean thickness of its two triangles, with the small-strain G.
-  std::map<std::pair<int, int>, int> face_of_edge;
-  for (int f = 0; f < m_faces.rows(); ++f)
-    for (int k = 0; k < 3; ++k) face_of_edge[{m_faces(f, k), m_faces(f, (k + 1) % 3)}] = f;
-  for (const auto& v : m_hinges) {
-    const double thickness = 0.5 * (m_thickness[static_cast<size_t>(face_of_edge.at({v[0], v[1]}))] +
-                                    m_thickness[static_cast<size_t>(face_of_edge.at({v[1], v[0]}))]);
+  for (const auto& [a, b] : hinge_faces) {
+    const double thickness = 0.5 * (m_thickness[static_cast<size_t>(a)] + m_thickness[static_cast<size_t>(b)]);
     m_hinge_modulus.push_back(bending_modulus(m_material.shear_modulus(), thickness));
   }
   update_rest_hinges();

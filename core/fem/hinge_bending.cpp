@@ -52,24 +52,31 @@ double bend_angle(double theta, double rest_angle) { return std::remainder(theta
 
 }  // namespace
 
-std::vector<HingeVertices> mesh_hinges(const Faces& faces) {
-  // Directed edge (a, b) -> the vertex opposite it in the triangle where it runs a -> b.
-  std::map<std::pair<int, int>, int> opposite;
+std::vector<HingeVertices> mesh_hinges(const Faces& faces, std::vector<std::array<int, 2>>* hinge_faces) {
+  // Directed edge (a, b) -> the triangle where it runs a -> b.
+  std::map<std::pair<int, int>, int> face_of;
   std::map<std::pair<int, int>, int> uses;
   for (int f = 0; f < faces.rows(); ++f) {
     for (int k = 0; k < 3; ++k) {
       const int a = faces(f, k), b = faces(f, (k + 1) % 3);
-      opposite[{a, b}] = faces(f, (k + 2) % 3);
+      face_of[{a, b}] = f;
       ++uses[{std::min(a, b), std::max(a, b)}];
     }
   }
+  auto opposite = [&](int face, int a, int b) {
+    for (int k = 0; k < 3; ++k)
+      if (faces(face, k) != a && faces(face, k) != b) return faces(face, k);
+    return -1;
+  };
   std::vector<HingeVertices> hinges;
-  for (const auto& [edge, opposite_vertex] : opposite) {
+  if (hinge_faces) hinge_faces->clear();
+  for (const auto& [edge, face] : face_of) {
     const auto [a, b] = edge;
     if (a > b || uses[{a, b}] != 2) continue;  // each edge once; an edge of more or fewer triangles has no hinge
-    const auto other = opposite.find({b, a});
-    if (other == opposite.end()) continue;  // the two triangles disagree in orientation
-    hinges.push_back({a, b, opposite_vertex, other->second});
+    const auto other = face_of.find({b, a});
+    if (other == face_of.end()) continue;  // the two triangles disagree in orientation
+    hinges.push_back({a, b, opposite(face, a, b), opposite(other->second, a, b)});
+    if (hinge_faces) hinge_faces->push_back({face, other->second});
   }
   return hinges;
 }

@@ -25,8 +25,9 @@ using Matrix12d = Eigen::Matrix<double, 12, 12>;
 /// The four vertices of one interior edge's hinge, in stencil order (see above).
 using HingeVertices = std::array<int, 4>;
 
-/// Every edge shared by exactly two triangles of a consistently oriented mesh, as a hinge.
-std::vector<HingeVertices> mesh_hinges(const Faces& faces);
+/// Every edge shared by exactly two triangles of a consistently oriented mesh, as a hinge. With
+/// `hinge_faces`, also the two triangles of each (the one with x0 -> x1 first).
+std::vector<HingeVertices> mesh_hinges(const Faces& faces, std::vector<std::array<int, 2>>* hinge_faces = nullptr);
 
 /// Rest-state data of one hinge.
 struct RestHinge {
