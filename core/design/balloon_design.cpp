@@ -5,6 +5,7 @@
 
 #include "design/augmented_lagrangian_design.hpp"
 #include "design/design_driver.hpp"
+#include "design/multiresolution_design.hpp"
 #include "design/reduced_space_design.hpp"
 #include "mesh/mesh_geometry.hpp"
 
@@ -74,6 +75,7 @@ DesignResult design_balloon(const TriMesh& target, const DesignOptions& options)
     result.inflated = target.vertices;
     return result;
   }
+  if (runs_coarse_to_fine(target, options)) return design_coarse_to_fine(target, options);
   DesignDriver driver(target, options);
   if (options.method == DesignMethod::AugmentedLagrangian) return run_augmented_lagrangian_design(driver);
   return run_reduced_space_design(driver);

@@ -65,6 +65,15 @@ struct DesignOptions {
   /// checkpoint's rest shape is brought to equilibrium and the iterations go on from its count. A
   /// checkpoint that does not fit the target or cannot be inflated is ignored (the design starts over).
   std::optional<DesignCheckpoint> resume;
+  /// Coarse-to-fine (adjoint only; multiresolution_design.hpp): a target with at least twice this many
+  /// vertices is first designed remeshed to about this many, where an iteration costs a sixth, and the
+  /// design continues from there at full resolution. 0 (the default: measured on the corpus, the carried
+  /// shape mostly could not be inflated or led to a worse stall; README "Design on the corpus") designs
+  /// at full resolution only. Not used with a nozzle, a given start or a checkpoint, which name
+  /// full-resolution vertices.
+  int coarse_vertices = 0;
+  /// The coarse stage's share of max_time_s (when there is a budget).
+  double coarse_time_fraction = 0.5;
   int progress_mesh_every = 5;          ///< attach the inflated mesh to every K-th progress event
   ProgressCallback progress;            ///< optional; phases "start", "design"
   const CancelToken* cancel = nullptr;  ///< optional; checked between iterations
@@ -77,6 +86,19 @@ struct ConvergenceSample {
   double avg_error_mm = 0.0;
   double max_error_mm = 0.0;
   double residual_norm = 0.0;  ///< force residual of the inflated shape (N)
+};
+
+/// The coarse stage of a coarse-to-fine design.
+struct CoarseStage {
+  int vertices = 0;          ///< the coarse target's vertices
+  int iterations = 0;        ///< iterations run on it
+  double time_s = 0.0;       ///< its wall time (s), included in the result's time_s and log
+  DesignStop stop = DesignStop::StartFailed;
+  /// Its average error against the coarse target (mm); none when its start was not inflated.
+  std::optional<double> avg_error_mm;
+  /// Its rest shape was carried to full resolution and the design went on from it there; false when the
+  /// carried shape could not be inflated (or there was none) and the full-resolution design started over.
+  bool carried = false;
 };
 
 struct DesignResult {
@@ -107,7 +129,8 @@ struct DesignResult {
   /// came within the contact distance); "nozzle" (nozzle vertices held); "sheet_bending" (the sheet's
   /// bending stiffness, switched on when the start wrinkled with no stable membrane state).
   std::vector<std::string> active_terms;
-  std::vector<ConvergenceSample> log;
+  std::vector<ConvergenceSample> log;   ///< full-resolution iterations only (times include the coarse stage)
+  std::optional<CoarseStage> coarse_stage;  ///< set when the design ran coarse-to-fine
 };
 
 /// Designs the rest shape for `target`. Never throws for bad numerics: failures are in the result.

@@ -26,7 +26,15 @@ Positions scaled_about_centroid(const Positions& points, double scale) {
   return scaled;
 }
 
-TriMesh start_shape(const TriMesh& target, const DesignOptions& options) {
+std::vector<bool> rigid_support(const TriMesh& mesh) {
+  std::vector<bool> fixed(static_cast<size_t>(3 * mesh.vertex_count()), false);
+  for (int c : rigid_support_coordinates(mesh.vertices)) fixed[static_cast<size_t>(c)] = true;
+  return fixed;
+}
+
+}  // namespace
+
+TriMesh design_start_shape(const TriMesh& target, const DesignOptions& options) {
   TriMesh start = target;
   const double scale = options.scale > 0 ? options.scale : std::cbrt(1.0 / options.volume_ratio);
   if (options.initial_rest.rows() == 0) {
@@ -38,14 +46,6 @@ TriMesh start_shape(const TriMesh& target, const DesignOptions& options) {
   start.vertices = scaled_about_centroid(options.initial_rest, std::cbrt(wanted_volume / given_volume));
   return start;
 }
-
-std::vector<bool> rigid_support(const TriMesh& mesh) {
-  std::vector<bool> fixed(static_cast<size_t>(3 * mesh.vertex_count()), false);
-  for (int c : rigid_support_coordinates(mesh.vertices)) fixed[static_cast<size_t>(c)] = true;
-  return fixed;
-}
-
-}  // namespace
 
 double design_clock_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -60,7 +60,7 @@ DesignDriver::DesignDriver(const TriMesh& target, const DesignOptions& options)
     : m_target(target),
       m_options(options),
       m_start(design_clock_s()),
-      m_rest_mesh(start_shape(target, options)),
+      m_rest_mesh(design_start_shape(target, options)),
       // Per-element thickness lives in the model from here on; nothing reads options.thickness_mm again.
       m_model(m_rest_mesh, options.material,
               std::vector<double>(static_cast<size_t>(target.face_count()), options.thickness_mm)),
@@ -152,7 +152,7 @@ bool DesignDriver::inflate_start_to_target_volume(const Eigen::VectorXd& rest, D
   return true;
 }
 
-bool DesignDriver::resume_from(const DesignCheckpoint& checkpoint, Eigen::VectorXd& rest) {
+bool DesignDriver::resume_from(const DesignCheckpoint& checkpoint, Eigen::VectorXd& rest, DesignResult& result) {
   if (checkpoint.rest.rows() != m_target.vertex_count() || checkpoint.rest.cols() != 3 ||
       !checkpoint.rest.allFinite() || checkpoint.iteration < 1 || checkpoint.iteration >= m_options.max_iterations)
     return false;
@@ -167,6 +167,20 @@ bool DesignDriver::resume_from(const DesignCheckpoint& checkpoint, Eigen::Vector
     m_model.set_rest_positions(unflatten(Eigen::VectorXd((1.0 - t) * rest + t * goal)));
     m_last_report = m_solver.solve_volume(x, pressure, m_target_volume, m_settings);
     if (!m_last_report.converged) {
+      // Where the path between the two rest shapes wrinkles, inflate the checkpoint's rest shape on its
+      // own, by the forward solver's volume path, as the start was.
+      if (!stopped()) {
+        DesignResult inflated;
+        const Eigen::VectorXd start_x = m_x;
+        const double start_pressure = m_pressure;
+        if (inflate_start_to_target_volume(goal, inflated)) {
+          for (const std::string& term : inflated.active_terms) result.active_terms.push_back(term);
+          rest = goal;
+          return true;
+        }
+        m_x = start_x;
+        m_pressure = start_pressure;
+      }
       m_model.set_rest_positions(unflatten(rest));
       return false;
     }

@@ -19,6 +19,10 @@ namespace balloon {
 
 constexpr double MPA_PER_KPA = 1e-3;
 
+/// The design's start rest shape: the target scaled about its centroid (DesignOptions::scale, or to
+/// 1/volume_ratio of its volume), or the given initial rest shape rescaled to that volume.
+TriMesh design_start_shape(const TriMesh& target, const DesignOptions& options);
+
 /// Steady-clock seconds (the clock of NewtonSettings::deadline_s).
 double design_clock_s();
 
@@ -60,7 +64,7 @@ class DesignDriver {
   /// Brings a checkpoint's rest shape (at this design's rest volume) to equilibrium from the inflated
   /// start, through rest shapes blended from the start's. On success `rest`, x and pressure are the
   /// checkpoint's; otherwise nothing changes.
-  bool resume_from(const DesignCheckpoint& checkpoint, Eigen::VectorXd& rest);
+  bool resume_from(const DesignCheckpoint& checkpoint, Eigen::VectorXd& rest, DesignResult& result);
   /// Volume-controlled equilibrium of `rest` from (x, p) with a short Newton budget; false when it does
   /// not converge (last_report() says why).
   bool equilibrium(const Eigen::VectorXd& rest, Eigen::VectorXd& x, double& pressure);

@@ -83,7 +83,7 @@ class ReducedSpaceDesign {
     if (!m_driver.inflate_start(rest, result)) return m_driver.finish(result, rest);
     int first_iteration = 1;
     double stall_reference = *result.baseline_avg_error_mm;  // best surface error at the last real improvement (mm)
-    if (m_options.resume && m_driver.resume_from(*m_options.resume, rest)) {
+    if (m_options.resume && m_driver.resume_from(*m_options.resume, rest, result)) {
       result.resumed_from_iteration = m_options.resume->iteration;
       first_iteration = m_options.resume->iteration + 1;
       const SurfaceDistanceStats resumed = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);

@@ -105,6 +105,7 @@ int main(int argc, char** argv) {
   bool quick = false;
   bool corpus = false;
   double volume_ratio = 8.0;
+  int coarse_vertices = balloon::DesignOptions{}.coarse_vertices;  // 0: full resolution only
   std::vector<std::string> mesh_filters, material_specs;
   std::vector<balloon::DesignMethod> methods = {balloon::DesignMethod::Adjoint,
                                                 balloon::DesignMethod::AugmentedLagrangian};
@@ -131,6 +132,8 @@ int main(int argc, char** argv) {
         return 2;
       }
       methods = {*method};
+    } else if (arg == "--coarse-vertices" && i + 1 < argc) {
+      coarse_vertices = std::atoi(argv[++i]);
     } else if (arg == "--volume-ratio" && i + 1 < argc) {
       volume_ratio = std::atof(argv[++i]);
     } else if (!arg.empty() && arg[0] != '-') {
@@ -138,7 +141,8 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: bench_design [OUT_DIR] [--data DIR] [--corpus] [--mesh SUBSTRING]... [--material SPEC]... "
-                   "[--resolution N] [--max-time S] [--volume-ratio R] [--method adjoint|alm] [--quick]\n");
+                   "[--resolution N] [--max-time S] [--volume-ratio R] [--method adjoint|alm] [--coarse-vertices N] "
+                   "[--quick]\n");
       return 2;
     }
   }
@@ -216,6 +220,7 @@ int main(int argc, char** argv) {
         options.volume_ratio = volume_ratio;
         options.method = method;
         options.max_time_s = max_time_s;
+        options.coarse_vertices = coarse_vertices;
         runs.push_back({shape.name, material_label, balloon::design_balloon(target->mesh, options)});
         const balloon::DesignResult& r = runs.back().result;
         // A value that was never computed prints as nan, never as 0.
@@ -228,6 +233,11 @@ int main(int argc, char** argv) {
                     shown(r.baseline_avg_error_mm), shown(r.baseline_max_error_mm),
                     shown(r.baseline_avg_error_mm) / shown(r.avg_error_mm), balloon::design_stop_name(r.stop).c_str(),
                     r.message.c_str());
+        if (r.coarse_stage)
+          std::printf("%-22s   coarse stage: %d vertices, %d iterations, %.1f s, %s, %s\n", "",
+                      r.coarse_stage->vertices, r.coarse_stage->iterations, r.coarse_stage->time_s,
+                      balloon::design_stop_name(r.coarse_stage->stop).c_str(),
+                      r.coarse_stage->carried ? "carried to full resolution" : "not carried (started over)");
         std::fflush(stdout);
         const std::string stem = out_dir + "/" + shape.name + (corpus ? "_" + material_label : "");
         std::ofstream(stem + "_" + method_name + "_convergence.csv") << balloon::jobs::convergence_csv(r.log);
