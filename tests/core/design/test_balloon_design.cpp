@@ -8,6 +8,7 @@
 #include <random>
 
 #include "design/balloon_design.hpp"
+#include "design_test_meshes.hpp"
 #include "mesh/icosphere.hpp"
 #include "mesh/mesh_io.hpp"
 #include "solve/inflation.hpp"
@@ -16,21 +17,9 @@ namespace balloon {
 namespace {
 
 TEST(BalloonDesign, RecoversTheBalloonOfAnInflatedEllipsoid) {
-  TriMesh rest = make_icosphere(20.0, 3);  // 642 vertices
-  for (int v = 0; v < rest.vertex_count(); ++v) {
-    rest.vertices(v, 0) *= 1.6;
-    rest.vertices(v, 2) *= 0.8;
-  }
-  InflationOptions inflation;
-  inflation.material = *parse_material_spec("silicone");
-  inflation.volume_ratio = 6.0;
-  const InflationResult inflated = inflate(rest, inflation);
-  ASSERT_TRUE(inflated.converged) << inflated.message;
-  TriMesh target = rest;
-  target.vertices = inflated.deformed;
-
+  const TriMesh target = design_test::inflated_ellipsoid_target();
   DesignOptions options;
-  options.material = inflation.material;
+  options.material = *parse_material_spec("silicone");
   options.volume_ratio = 6.0;
   options.max_time_s = 120;
   const DesignResult design = design_balloon(target, options);
@@ -46,18 +35,7 @@ TEST(BalloonDesign, RecoversTheBalloonOfAnInflatedEllipsoid) {
 }
 
 /// A target that has an exact answer: a 162-vertex ellipsoid (semi-axes 32, 20, 20 mm) inflated six-fold.
-TriMesh inflated_small_ellipsoid() {
-  TriMesh rest = make_icosphere(20.0, 2);
-  for (int v = 0; v < rest.vertex_count(); ++v) rest.vertices(v, 0) *= 1.6;
-  InflationOptions inflation;
-  inflation.material = *parse_material_spec("silicone");
-  inflation.volume_ratio = 6.0;
-  const InflationResult inflated = inflate(rest, inflation);
-  EXPECT_TRUE(inflated.converged) << inflated.message;
-  TriMesh target = rest;
-  target.vertices = inflated.deformed;
-  return target;
-}
+TriMesh inflated_small_ellipsoid() { return design_test::inflated_ellipsoid_target(2, 1.0); }
 
 TEST(BalloonDesign, AugmentedLagrangianRecoversTheBalloonAndEndsInEquilibrium) {
   const TriMesh target = inflated_small_ellipsoid();

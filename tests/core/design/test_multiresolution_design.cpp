@@ -7,8 +7,8 @@
 #include "design/balloon_design.hpp"
 #include "design/multiresolution_design.hpp"
 #include "design/surface_transfer.hpp"
+#include "design_test_meshes.hpp"
 #include "mesh/icosphere.hpp"
-#include "solve/inflation.hpp"
 
 namespace balloon {
 namespace {
@@ -40,22 +40,9 @@ TEST(SurfaceTransfer, RefusesAFieldOfTheWrongSize) {
 }
 
 TEST(MultiresolutionDesign, CarriesTheCoarseRestShapeAndKeepsTheFullResolutionBaseline) {
-  // A known answer: a 642-vertex ellipsoid (semi-axes 32, 20, 16 mm) inflated six-fold.
-  TriMesh rest = make_icosphere(20.0, 3);
-  for (int v = 0; v < rest.vertex_count(); ++v) {
-    rest.vertices(v, 0) *= 1.6;
-    rest.vertices(v, 2) *= 0.8;
-  }
-  InflationOptions inflation;
-  inflation.material = *parse_material_spec("silicone");
-  inflation.volume_ratio = 6.0;
-  const InflationResult inflated = inflate(rest, inflation);
-  ASSERT_TRUE(inflated.converged) << inflated.message;
-  TriMesh target = rest;
-  target.vertices = inflated.deformed;
-
+  const TriMesh target = design_test::inflated_ellipsoid_target();  // a known answer, 642 vertices
   DesignOptions options;
-  options.material = inflation.material;
+  options.material = *parse_material_spec("silicone");
   options.volume_ratio = 6.0;
   options.max_time_s = 120;
   options.coarse_vertices = 200;
