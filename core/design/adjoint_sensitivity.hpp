@@ -7,6 +7,10 @@
 /// gradient (adjoint) and its linear predictor (the first-order response to a rest step) both solve with
 /// the one factorization of K made in `prepare`. Positions are flat 3#V vectors (mm).
 #include <Eigen/Core>
+#include <vector>
+
+#include "fem/hinge_bending.hpp"
+#include "fem/membrane_element.hpp"
 
 #include "fem/balloon_model.hpp"
 #include "solve/equilibrium_solver.hpp"
@@ -19,8 +23,10 @@ class AdjointSensitivity {
   /// thickness are the ones differentiated. Both must outlive this object.
   AdjointSensitivity(const fem::BalloonModel& model, EquilibriumSolver& solver);
 
-  /// Factorizes K at the equilibrium (x, pressure_mpa) of the model's current rest shape `rest`, and
-  /// solves K b = v once. False when K is singular or v^T K^-1 v vanishes (no sensitivity is defined).
+  /// Factorizes K at the equilibrium (x, pressure_mpa) of the model's current rest shape `rest`, solves
+  /// K b = v once, and evaluates M's element blocks once (the Gauss-Newton directions apply M and M^T
+  /// about forty times per iteration). False when K is singular or v^T K^-1 v vanishes (no sensitivity
+  /// is defined).
   bool prepare(const Eigen::VectorXd& rest, const Eigen::VectorXd& x, double pressure_mpa);
 
   /// dJ/d rest (3#V) of J(x(rest)) at the prepared equilibrium, from `objective_gradient_x` = dJ/dx
@@ -32,7 +38,8 @@ class AdjointSensitivity {
   void linear_response(const Eigen::VectorXd& direction, Eigen::VectorXd& dx, double& dp) const;
 
   /// M s (transpose false) or M^T s (transpose true) at (rest, x): how the forces change with the rest
-  /// shape, or how forces weighted by s change with it. Summed over triangles; 3#V in and out.
+  /// shape, or how forces weighted by s change with it. Summed over triangles (and the sheet's bending
+  /// hinges when on); 3#V in and out. Evaluates the element blocks at (rest, x) anew.
   Eigen::VectorXd mixed_product(const Eigen::VectorXd& rest, const Eigen::VectorXd& x, const Eigen::VectorXd& s,
                                 bool transpose) const;
 
@@ -41,9 +48,18 @@ class AdjointSensitivity {
   const Eigen::VectorXd& volume_response() const { return m_volume_response; }
 
  private:
+  /// M's element blocks: one 9x9 per triangle, one 12x12 per bending hinge (none when bending is off).
+  struct MixedBlocks {
+    std::vector<fem::Matrix9d> triangles;
+    std::vector<fem::Matrix12d> hinges;
+  };
+  MixedBlocks mixed_blocks(const Eigen::VectorXd& rest, const Eigen::VectorXd& x) const;
+  Eigen::VectorXd apply_mixed(const MixedBlocks& blocks, const Eigen::VectorXd& s, bool transpose) const;
+
   const fem::BalloonModel& m_model;
   EquilibriumSolver& m_solver;
   Eigen::VectorXd m_rest, m_x;
+  MixedBlocks m_mixed;  ///< at the prepared (rest, x)
   Eigen::VectorXd m_volume_gradient, m_volume_response;
 };
 
