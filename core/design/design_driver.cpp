@@ -191,6 +191,25 @@ bool DesignDriver::resume_from(const DesignCheckpoint& checkpoint, Eigen::Vector
   return true;
 }
 
+bool DesignDriver::switch_bending_on(const Eigen::VectorXd& rest, DesignResult& result) {
+  if (m_model.bending() || m_options.method != DesignMethod::Adjoint) return false;
+  m_model.set_rest_positions(unflatten(rest));
+  m_model.set_bending(true);
+  m_solver.refresh_pattern();
+  Eigen::VectorXd x = m_x;
+  double pressure = m_pressure;
+  m_last_report = m_solver.solve_volume(x, pressure, m_target_volume, m_settings);
+  if (!m_last_report.converged) {
+    m_model.set_bending(false);
+    m_solver.refresh_pattern();
+    return false;
+  }
+  m_x = x;
+  m_pressure = pressure;
+  result.active_terms.push_back("sheet_bending");
+  return true;
+}
+
 bool DesignDriver::equilibrium(const Eigen::VectorXd& rest, Eigen::VectorXd& x, double& pressure) {
   m_model.set_rest_positions(unflatten(rest));
   // A trial starts a first-order step from its solution; one that needs many Newton steps has entered

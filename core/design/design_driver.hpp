@@ -62,9 +62,15 @@ class DesignDriver {
   /// it on the target, and records the baseline as iteration 0. False (result stop set) when it fails.
   bool inflate_start(const Eigen::VectorXd& rest, DesignResult& result);
   /// Brings a checkpoint's rest shape (at this design's rest volume) to equilibrium from the inflated
-  /// start, through rest shapes blended from the start's. On success `rest`, x and pressure are the
-  /// checkpoint's; otherwise nothing changes.
+  /// start, through rest shapes blended from the start's, or, where that path wrinkles, inflated on its
+  /// own like the start (a term that switched on, e.g. sheet_bending, goes into `result`). On success
+  /// `rest`, x and pressure are the checkpoint's; otherwise nothing changes.
   bool resume_from(const DesignCheckpoint& checkpoint, Eigen::VectorXd& rest, DesignResult& result);
+  /// After a trial that crept through wrinkles with no stable membrane state (creeping_through_wrinkles):
+  /// switches the sheet's bending on for the rest of the design (term sheet_bending) and brings the
+  /// current `rest` to equilibrium with it from x. False, with bending off again and x unchanged, when it
+  /// is on already, the method is alm (membrane-only derivatives) or that equilibrium is not found.
+  bool switch_bending_on(const Eigen::VectorXd& rest, DesignResult& result);
   /// Volume-controlled equilibrium of `rest` from (x, p) with a short Newton budget; false when it does
   /// not converge (last_report() says why).
   bool equilibrium(const Eigen::VectorXd& rest, Eigen::VectorXd& x, double& pressure);

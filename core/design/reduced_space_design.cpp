@@ -143,7 +143,7 @@ class ReducedSpaceDesign {
       Eigen::VectorXd response;
       double pressure_response = 0.0;
       m_sensitivity.linear_response(direction, response, pressure_response);
-      bool accepted = false;
+      bool accepted = false, bending_switched = false;
       Eigen::VectorXd trial_rest, trial_x;
       double trial_pressure = 0.0, trial_objective = 0.0;
       for (int k = 0; k < 12; ++k, t *= 0.5) {
@@ -156,6 +156,12 @@ class ReducedSpaceDesign {
                        m_last_report.iterations, m_last_report.message.c_str(), design_clock_s() - m_driver.start_time());
         if (!balanced) {
           if (m_driver.stopped()) break;
+          // A step into compression with no stable membrane state: the real sheet's bending gives those
+          // regions one. Switched on once; the iteration then starts over from the same rest shape.
+          if (creeping_through_wrinkles(m_last_report) && m_driver.switch_bending_on(rest, result)) {
+            bending_switched = true;
+            break;
+          }
           continue;
         }
         trial_objective = m_objective.value(trial_rest, trial_x);
@@ -163,6 +169,17 @@ class ReducedSpaceDesign {
           accepted = true;
           break;
         }
+      }
+      if (bending_switched) {
+        m_objective.realign(m_x);
+        objective = m_objective.value(rest, m_x);
+        m_lbfgs.clear();
+        if (!objective_gradient(rest, gradient)) {
+          stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized");
+          break;
+        }
+        --iteration;  // no step was taken
+        continue;
       }
       if (!accepted) {
         if (m_driver.stopped()) {

@@ -47,6 +47,12 @@ struct NewtonReport {
   int indefinite_factorizations = 0;
 };
 
+/// A failed solve that found the stiffness indefinite at most of its exact factorizations: compressed
+/// regions wrinkling with no stable membrane state (as opposed to a slow but stable path).
+inline bool creeping_through_wrinkles(const NewtonReport& report) {
+  return !report.converged && 2 * report.indefinite_factorizations > report.exact_factorizations;
+}
+
 /// Convergence test: |r| <= relative_tolerance * F with the force scale F = |p| |grad V| + 1e-3 G h sqrt(A)
 /// (G the small-strain shear modulus, h the mean thickness, A the rest area: a thousandth of the membrane
 /// force a unit strain would cause), so the test keeps its meaning near zero pressure; under volume

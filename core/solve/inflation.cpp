@@ -308,12 +308,6 @@ class InflationRun {
     return true;
   }
 
-  /// The failed volume step found the stiffness indefinite at most of its exact factorizations: compressed
-  /// regions wrinkling with no stable membrane state (as opposed to a slow but stable path).
-  static bool creeping_through_wrinkles(const NewtonReport& report) {
-    return 2 * report.indefinite_factorizations > report.exact_factorizations;
-  }
-
   /// Under BendingUse::Auto, a volume step that failed as a pure membrane switches the sheet's bending
   /// stiffness on for the rest of the path (the hinges widen the solver's pattern). True if it did.
   bool switch_bending_on() {

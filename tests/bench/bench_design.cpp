@@ -233,6 +233,8 @@ int main(int argc, char** argv) {
                     shown(r.baseline_avg_error_mm), shown(r.baseline_max_error_mm),
                     shown(r.baseline_avg_error_mm) / shown(r.avg_error_mm), balloon::design_stop_name(r.stop).c_str(),
                     r.message.c_str());
+        if (std::find(r.active_terms.begin(), r.active_terms.end(), "sheet_bending") != r.active_terms.end())
+          std::printf("%-22s   the sheet's bending was on (the membrane alone wrinkled with no stable state)\n", "");
         if (r.coarse_stage)
           std::printf("%-22s   coarse stage: %d vertices, %d iterations, %.1f s, %s, %s\n", "",
                       r.coarse_stage->vertices, r.coarse_stage->iterations, r.coarse_stage->time_s,

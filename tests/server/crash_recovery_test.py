@@ -320,9 +320,10 @@ def main():
         for failed in other_failures[:10]:
             print(f"  failed: {failed}", flush=True)
 
-        # A job that crashes the server every time it runs: kill whenever it is RUNNING, three times.
+        # A job that crashes the server every time it runs: kill whenever it is RUNNING, three times. It
+        # must run well beyond the 50 ms poll: a sphere's design is done in about that, an ellipsoid's is not.
         heavy = pb.SubmitJobRequest(request_id="crasher", spec=pb.JobSpec(design=pb.DesignJob(
-            target_mesh=pb.MeshFile(data=icosphere_obj(2, 10.0), format=pb.MESH_FORMAT_OBJ),
+            target_mesh=pb.MeshFile(data=icosphere_obj(3, 10.0, scale=(1.6, 1.0, 0.8)), format=pb.MESH_FORMAT_OBJ),
             material=pb.MaterialRef(name="latex"), thickness_mm=0.5, resolution=0, max_time_s=60.0)))
         crasher = api.retrying(api.submit, heavy, "alice")[0].job.id
         for attempt in range(1, 4):
