@@ -207,6 +207,7 @@ bool DesignDriver::switch_bending_on(const Eigen::VectorXd& rest, DesignResult& 
   m_x = x;
   m_pressure = pressure;
   result.active_terms.push_back("sheet_bending");
+  debug_time("the sheet's bending switched on");
   return true;
 }
 
