@@ -171,15 +171,16 @@ bool DesignDriver::resume_from(const DesignCheckpoint& checkpoint, Eigen::Vector
       // own, by the forward solver's volume path, as the start was.
       if (!stopped()) {
         DesignResult inflated;
-        const Eigen::VectorXd start_x = m_x;
-        const double start_pressure = m_pressure;
-        if (inflate_start_to_target_volume(goal, inflated)) {
+        const bool had_bending = m_model.bending();
+        if (inflate_start_to_target_volume(goal, inflated)) {  // x and pressure change only on success
           for (const std::string& term : inflated.active_terms) result.active_terms.push_back(term);
           rest = goal;
           return true;
         }
-        m_x = start_x;
-        m_pressure = start_pressure;
+        if (m_model.bending() != had_bending) {  // switched on for a state that then did not settle
+          m_model.set_bending(had_bending);
+          m_solver.refresh_pattern();
+        }
       }
       m_model.set_rest_positions(unflatten(rest));
       return false;
