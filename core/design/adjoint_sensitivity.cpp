@@ -9,8 +9,6 @@ AdjointSensitivity::AdjointSensitivity(const fem::BalloonModel& model, Equilibri
     : m_model(model), m_solver(solver) {}
 
 bool AdjointSensitivity::prepare(const Eigen::VectorXd& rest, const Eigen::VectorXd& x, double pressure_mpa) {
-  m_rest = rest;
-  m_x = x;
   if (!m_solver.factorize_exact(x, pressure_mpa)) return false;
   m_volume_gradient = m_model.volume_gradient(x);
   m_volume_response = m_solver.solve_with_factorization(m_volume_gradient);
@@ -35,7 +33,7 @@ void AdjointSensitivity::linear_response(const Eigen::VectorXd& direction, Eigen
   dp = std::abs(vb) > 0.0 ? -v.dot(a) / vb : 0.0;
   dx = a + dp * b;
   if (!dx.allFinite()) {
-    dx.setZero(m_rest.size());
+    dx.setZero(direction.size());
     dp = 0.0;
   }
 }

@@ -58,7 +58,6 @@ class AdjointSensitivity {
 
   const fem::BalloonModel& m_model;
   EquilibriumSolver& m_solver;
-  Eigen::VectorXd m_rest, m_x;
   MixedBlocks m_mixed;  ///< at the prepared (rest, x)
   Eigen::VectorXd m_volume_gradient, m_volume_response;
 };

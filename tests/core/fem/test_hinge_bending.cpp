@@ -8,6 +8,7 @@
 #include <cmath>
 #include <random>
 
+#include "core/central_differences.hpp"
 #include "fem/assembly.hpp"
 #include "fem/balloon_model.hpp"
 #include "fem/hinge_bending.hpp"
@@ -54,15 +55,10 @@ TEST(HingeBending, GradientAndHessianMatchCentralDifferences) {
       EXPECT_NEAR(energy, hinge_energy(rest, x), 1e-15 * (1.0 + energy));
       EXPECT_LT((gradient - hinge_energy_gradient(rest, x)).norm(), 1e-12 * (1.0 + gradient.norm()));
       const double h = 1e-6 * wing;
-      Vector12d fd_gradient;
-      Matrix12d fd_hessian;
-      for (int i = 0; i < 12; ++i) {
-        Vector12d plus = x, minus = x;
-        plus[i] += h;
-        minus[i] -= h;
-        fd_gradient[i] = (hinge_energy(rest, plus) - hinge_energy(rest, minus)) / (2 * h);
-        fd_hessian.col(i) = (hinge_energy_gradient(rest, plus) - hinge_energy_gradient(rest, minus)) / (2 * h);
-      }
+      const Vector12d fd_gradient =
+          test::central_difference_gradient([&](const Vector12d& y) { return hinge_energy(rest, y); }, x, h);
+      const Matrix12d fd_hessian =
+          test::central_difference_jacobian([&](const Vector12d& y) { return hinge_energy_gradient(rest, y); }, x, h);
       SCOPED_TRACE(testing::Message() << "fold " << fold << ", wing " << wing);
       EXPECT_LT((gradient - fd_gradient).norm(), 1e-6 * gradient.norm() + 1e-9);
       EXPECT_LT((hessian - fd_hessian).norm(), 1e-6 * hessian.norm() + 1e-9);
@@ -85,15 +81,8 @@ TEST(HingeBending, MixedRestDerivativeMatchesCentralDifferences) {
     }
     const double modulus = 0.02;
     const Matrix12d mixed = hinge_mixed_derivative(make_rest_hinge(rest, modulus), rest, x);
-    Matrix12d fd;
-    const double h = 1e-6;
-    for (int j = 0; j < 12; ++j) {
-      Vector12d plus = rest, minus = rest;
-      plus[j] += h;
-      minus[j] -= h;
-      fd.col(j) = (hinge_energy_gradient(make_rest_hinge(plus, modulus), x) -
-                   hinge_energy_gradient(make_rest_hinge(minus, modulus), x)) / (2 * h);
-    }
+    const Matrix12d fd = test::central_difference_jacobian(
+        [&](const Vector12d& r) { return hinge_energy_gradient(make_rest_hinge(r, modulus), x); }, rest, 1e-6);
     EXPECT_LT((mixed - fd).norm(), 1e-6 * mixed.norm()) << "fold " << fold;
     EXPECT_GT(mixed.norm(), 0.0);
   }

@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <random>
 
+#include "core/central_differences.hpp"
 #include "fem/membrane_element.hpp"
 
 namespace balloon::fem {
@@ -74,14 +75,9 @@ TEST_P(MembraneElementTest, GradientMatchesFiniteDifferencesOfEnergy) {
     const Vector9d x = deformed_triangle(rng, rest, c.stretch);
     const RestTriangle r = make_rest_triangle(rest);
     const Vector9d analytic = membrane_gradient(c.material, 0.5, r, x);
-    Vector9d numeric;
     const double step = 1e-6 * x.norm() * (c.sliver ? 1e-2 : 1.0);
-    for (int i = 0; i < 9; ++i) {
-      Vector9d xp = x, xm = x;
-      xp[i] += step;
-      xm[i] -= step;
-      numeric[i] = (membrane_energy(c.material, 0.5, r, xp) - membrane_energy(c.material, 0.5, r, xm)) / (2 * step);
-    }
+    const Vector9d numeric = test::central_difference_gradient(
+        [&](const Vector9d& y) { return membrane_energy(c.material, 0.5, r, y); }, x, step);
     ASSERT_GT(analytic.norm(), 1e-10) << c.label;
     // A sliver's energy carries cancellation error (det M ~ 1e-6), which the difference quotient amplifies.
     EXPECT_LT(relative_error(analytic, numeric), c.sliver ? 1e-4 : 1e-6) << c.label << " trial " << trial;
@@ -99,14 +95,9 @@ TEST_P(MembraneElementTest, HessianMatchesFiniteDifferencesOfGradient) {
     Vector9d gradient;
     Matrix9d analytic;
     membrane_energy_gradient_hessian(c.material, 0.5, r, x, energy, gradient, analytic);
-    Matrix9d numeric;
     const double step = 1e-6 * x.norm() * (c.sliver ? 1e-2 : 1.0);
-    for (int i = 0; i < 9; ++i) {
-      Vector9d xp = x, xm = x;
-      xp[i] += step;
-      xm[i] -= step;
-      numeric.col(i) = (membrane_gradient(c.material, 0.5, r, xp) - membrane_gradient(c.material, 0.5, r, xm)) / (2 * step);
-    }
+    const Matrix9d numeric = test::central_difference_jacobian(
+        [&](const Vector9d& y) { return membrane_gradient(c.material, 0.5, r, y); }, x, step);
     ASSERT_GT(analytic.norm(), 1e-10) << c.label;
     EXPECT_LT(relative_error(analytic, numeric), 1e-5) << c.label << " trial " << trial;
     EXPECT_LT((analytic - analytic.transpose()).norm(), 1e-7 * analytic.norm()) << c.label;
@@ -120,16 +111,9 @@ TEST_P(MembraneElementTest, MixedRestDerivativeMatchesFiniteDifferences) {
     const Vector9d rest = rest_triangle(rng, c.sliver);
     const Vector9d x = deformed_triangle(rng, rest, c.stretch);
     const Matrix9d analytic = membrane_mixed_derivative(c.material, 0.5, rest, x);
-    Matrix9d numeric;
     const double step = 1e-6 * rest.norm() * (c.sliver ? 1e-2 : 1.0);
-    for (int j = 0; j < 9; ++j) {
-      Vector9d rp = rest, rm = rest;
-      rp[j] += step;
-      rm[j] -= step;
-      numeric.col(j) = (membrane_gradient(c.material, 0.5, make_rest_triangle(rp), x) -
-                        membrane_gradient(c.material, 0.5, make_rest_triangle(rm), x)) /
-                       (2 * step);
-    }
+    const Matrix9d numeric = test::central_difference_jacobian(
+        [&](const Vector9d& y) { return membrane_gradient(c.material, 0.5, make_rest_triangle(y), x); }, rest, step);
     ASSERT_GT(analytic.norm(), 1e-10) << c.label;
     EXPECT_LT(relative_error(analytic, numeric), 1e-5) << c.label << " trial " << trial;
   }
@@ -233,15 +217,8 @@ TEST_P(TensionFieldTest, GradientMatchesFiniteDifferencesOfRelaxedEnergy) {
     const RestTriangle r = make_rest_triangle(rest);
     EXPECT_EQ(is_relaxed(r, x), c.l1 * c.l2 * c.l2 < 1.0) << c.label;
     const Vector9d analytic = membrane_gradient(c.material, 0.5, r, x, true);
-    Vector9d numeric;
-    const double step = 1e-6 * x.norm();
-    for (int i = 0; i < 9; ++i) {
-      Vector9d xp = x, xm = x;
-      xp[i] += step;
-      xm[i] -= step;
-      numeric[i] =
-          (membrane_energy(c.material, 0.5, r, xp, true) - membrane_energy(c.material, 0.5, r, xm, true)) / (2 * step);
-    }
+    const Vector9d numeric = test::central_difference_gradient(
+        [&](const Vector9d& y) { return membrane_energy(c.material, 0.5, r, y, true); }, x, 1e-6 * x.norm());
     ASSERT_GT(analytic.norm(), 1e-6) << c.label;
     EXPECT_LT(relative_error(analytic, numeric), 1e-6) << c.label << " trial " << trial;
   }
@@ -259,15 +236,8 @@ TEST_P(TensionFieldTest, HessianMatchesFiniteDifferencesOfGradientAndIsPositiveS
     Matrix9d analytic;
     membrane_energy_gradient_hessian(c.material, 0.5, r, x, energy, gradient, analytic, false, true);
     EXPECT_NEAR(energy, membrane_energy(c.material, 0.5, r, x, true), 1e-12 * std::abs(energy)) << c.label;
-    Matrix9d numeric;
-    const double step = 1e-6 * x.norm();
-    for (int i = 0; i < 9; ++i) {
-      Vector9d xp = x, xm = x;
-      xp[i] += step;
-      xm[i] -= step;
-      numeric.col(i) =
-          (membrane_gradient(c.material, 0.5, r, xp, true) - membrane_gradient(c.material, 0.5, r, xm, true)) / (2 * step);
-    }
+    const Matrix9d numeric = test::central_difference_jacobian(
+        [&](const Vector9d& y) { return membrane_gradient(c.material, 0.5, r, y, true); }, x, 1e-6 * x.norm());
     ASSERT_GT(analytic.norm(), 1e-6) << c.label;
     EXPECT_LT(relative_error(analytic, numeric), 1e-5) << c.label << " trial " << trial;
     if (is_relaxed(r, x)) {
@@ -283,16 +253,9 @@ TEST_P(TensionFieldTest, MixedRestDerivativeMatchesFiniteDifferences) {
   Vector9d rest, x;
   tension_pair(rng, c.l1, c.l2, rest, x);
   const Matrix9d analytic = membrane_mixed_derivative(c.material, 0.5, rest, x, true);
-  Matrix9d numeric;
-  const double step = 1e-6 * rest.norm();
-  for (int j = 0; j < 9; ++j) {
-    Vector9d rp = rest, rm = rest;
-    rp[j] += step;
-    rm[j] -= step;
-    numeric.col(j) = (membrane_gradient(c.material, 0.5, make_rest_triangle(rp), x, true) -
-                      membrane_gradient(c.material, 0.5, make_rest_triangle(rm), x, true)) /
-                     (2 * step);
-  }
+  const Matrix9d numeric = test::central_difference_jacobian(
+      [&](const Vector9d& y) { return membrane_gradient(c.material, 0.5, make_rest_triangle(y), x, true); }, rest,
+      1e-6 * rest.norm());
   ASSERT_GT(analytic.norm(), 1e-6) << c.label;
   EXPECT_LT(relative_error(analytic, numeric), 1e-5) << c.label;
 }

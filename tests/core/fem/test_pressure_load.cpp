@@ -3,6 +3,7 @@
 
 #include <random>
 
+#include "core/central_differences.hpp"
 #include "fem/pressure_load.hpp"
 
 namespace balloon::fem {
@@ -16,16 +17,11 @@ TEST(PressureLoad, GradientAndHessianMatchFiniteDifferences) {
     for (int i = 0; i < 9; ++i) x[i] = u(rng);
     const Vector9d g = triangle_volume_gradient(x);
     const Matrix9d h = triangle_volume_hessian(x);
-    Vector9d g_fd;
-    Matrix9d h_fd;
     const double step = 1e-6;
-    for (int i = 0; i < 9; ++i) {
-      Vector9d xp = x, xm = x;
-      xp[i] += step;
-      xm[i] -= step;
-      g_fd[i] = (triangle_signed_volume(xp) - triangle_signed_volume(xm)) / (2 * step);
-      h_fd.col(i) = (triangle_volume_gradient(xp) - triangle_volume_gradient(xm)) / (2 * step);
-    }
+    const Vector9d g_fd = test::central_difference_gradient(
+        [](const Vector9d& y) { return triangle_signed_volume(y); }, x, step);
+    const Matrix9d h_fd = test::central_difference_jacobian(
+        [](const Vector9d& y) { return triangle_volume_gradient(y); }, x, step);
     ASSERT_GT(g.norm(), 1e-6);
     ASSERT_GT(h.norm(), 1e-6);
     EXPECT_LT((g - g_fd).norm(), 1e-8 * g.norm());
