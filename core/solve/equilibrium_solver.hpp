@@ -102,6 +102,15 @@ class EquilibriumSolver {
 
   int factorizations() const { return m_solver.factorizations(); }
 
+  /// The held coordinates are a rigid support (rigid_support_coordinates), not physical supports. Descent
+  /// steps of volume control then drop their rigid-motion part: against six held coordinates a step
+  /// carries whatever rotation brings them back to place, and a large linearised rotation adds a
+  /// spurious second-order volume and energy that cut the line search short (the trefoil knot's design
+  /// start, silicone: 265 -> 66 Newton steps with the second-order correction of constrained_descent).
+  /// solve_volume then ends with the rigid motion that returns the held coordinates to their values on
+  /// entry.
+  void set_support_is_rigid(bool rigid);
+
   /// Rebuilds the sparsity pattern and forgets the step history after the model's hinges changed
   /// (BalloonModel::set_bending): the same fixed coordinates, a new symbolic analysis.
   void refresh_pattern();
@@ -119,9 +128,16 @@ class EquilibriumSolver {
   bool sqp_step(Eigen::VectorXd& x, double& pressure_mpa, double target_volume, const Eigen::VectorXd& v,
                 const Eigen::VectorXd& r, double c, double shift_restart);
   /// KKT step of the factorized positive definite Hessian (model), line-searched on the augmented
-  /// Lagrangian at the new multiplier or on a clear fall of the KKT residual. False if no step helped.
-  bool constrained_descent(Eigen::VectorXd& x, double& pressure_mpa, double target_volume, const Eigen::VectorXd& v,
-                           const Eigen::VectorXd& r, double c);
+  /// Lagrangian at the new multiplier or on a clear fall of the KKT residual. The number of step
+  /// halvings the accepted step needed, or -1 if no step helped.
+  int constrained_descent(Eigen::VectorXd& x, double& pressure_mpa, double target_volume, const Eigen::VectorXd& v,
+                          const Eigen::VectorXd& r, double c);
+  /// A step over the free coordinates as a step of all of them (see set_support_is_rigid).
+  Eigen::VectorXd full_step(const Eigen::VectorXd& x, const Eigen::VectorXd& free_step) const;
+  NewtonReport newton_volume(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
+                             const NewtonSettings& settings);
+  /// After a solve on a rigid support: back to the held values, and the residual measured there.
+  void return_to_support(Eigen::VectorXd& x, const Eigen::VectorXd& held, double pressure_mpa, NewtonReport& report) const;
   /// LDL^T of the exact stiffness assembled last; records whether it was indefinite.
   bool factorize_exact_ldlt();
   /// Exact stiffness for the volume-controlled KKT step, accepted when its inertia is right.
@@ -138,6 +154,7 @@ class EquilibriumSolver {
   bool m_last_step_exact = false;  ///< the last volume step was the exact one
   bool m_exact_indefinite = false;  ///< the last exact stiffness had negative pivots: skip the LL^T attempt
   double m_force_floor = 0.0;  ///< N, see force_scale()
+  std::vector<int> m_support;  ///< the held coordinates, when they are a rigid support; else empty
 };
 
 }  // namespace balloon

@@ -74,6 +74,7 @@ class InflationRun {
         m_fixed(fixed_coordinates(rest, options)),
         m_solver(m_model, m_fixed),
         m_start(now_s()) {
+    m_solver.set_support_is_rigid(!has_user_fixed_vertices());
     m_settings.relative_tolerance = options.residual_tolerance;
     m_settings.max_iterations = 60;
     m_settings.shift_restart = options.sqp_shift_restart;
