@@ -263,7 +263,7 @@ NewtonReport EquilibriumSolver::newton_volume(Eigen::VectorXd& x, double& pressu
     if (exact_factorized && m_last_unstable_modes == 0 && m_solver.negative_pivots() == 0) {
       // K positive definite: the exact step descends on the augmented Lagrangian, a better guide
       // than the residual norm far from a solution.
-      exact = constrained_descent(x, pressure_mpa, target_volume, v, r, c) >= 0;
+      exact = constrained_descent(x, pressure_mpa, target_volume, v, r, c, true) >= 0;
       if (!exact) m_exact_fails_left = 2;
     } else if (exact_factorized) {
       const Eigen::VectorXd a = -m_solver.solve(r);
@@ -356,7 +356,7 @@ bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, doubl
     if (!factorized) shift *= 10.0;
   }
   m_sqp_shift = shift;
-  const int halvings = constrained_descent(x, pressure_mpa, target_volume, v, r, c);
+  const int halvings = constrained_descent(x, pressure_mpa, target_volume, v, r, c, false);
   if (halvings >= 0) {
     // Cut short more than twice: the shifted model was too bold, so the next one starts stiffer. (Only
     // here: exact steps cut short once raised it too, x4 per step without bound, until a later SQP
@@ -371,7 +371,8 @@ bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, doubl
 }
 
 int EquilibriumSolver::constrained_descent(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
-                                            const Eigen::VectorXd& v, const Eigen::VectorXd& r, double c) {
+                                           const Eigen::VectorXd& v, const Eigen::VectorXd& r, double c,
+                                           bool exact_model) {
   // KKT step of the factorized positive definite model H: H dx - dp v = -r, v.dx = -c.
   const Eigen::VectorXd a = m_solver.solve(r);
   const Eigen::VectorXd b = m_solver.solve(v);
@@ -388,7 +389,7 @@ int EquilibriumSolver::constrained_descent(Eigen::VectorXd& x, double& pressure_
     return m_model.elastic_energy(y) - trial_pressure * cy + 0.5 * kappa * cy * cy;
   };
   const double slope = (r - dp * v + kappa * c * v).dot(dx);
-  const Eigen::VectorXd step = full_step(x, dx);
+  const Eigen::VectorXd step = exact_model ? full_step(x, dx) : m_assembly.extend(dx);
   const double value = merit(x);
   // Close to a solution the merit's change drowns in the round-off of W; a clear fall of the KKT
   // residual (force and volume, each against its own scale) then decides.
@@ -409,7 +410,7 @@ int EquilibriumSolver::constrained_descent(Eigen::VectorXd& x, double& pressure_
       pressure_mpa = pressure_mpa + t * dp;
       return k;
     }
-    if (k == 0) {
+    if (k == 0 && exact_model) {
       // Second-order correction (the Maratos effect): a full step along a soft direction can carry a
       // second-order volume error that the merit rejects although the step is good. Taking the full
       // step's own volume error back along H^-1 v costs no solve.
