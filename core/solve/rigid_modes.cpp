@@ -5,36 +5,15 @@
 #include <Eigen/QR>
 
 namespace balloon {
-
-std::vector<int> rigid_support_coordinates(const Positions& positions) {
-  const Eigen::Index n = positions.rows();
-  const Eigen::RowVector3d center = positions.colwise().mean();
-  const double scale = std::max(1e-12, (positions.rowwise() - center).rowwise().norm().maxCoeff());
-  // Rows: 3 translations and 3 rotations (about the centroid, scaled to unit lever arm).
-  Eigen::MatrixXd modes = Eigen::MatrixXd::Zero(6, 3 * n);
-  for (Eigen::Index v = 0; v < n; ++v) {
-    const Eigen::Vector3d r = (positions.row(v) - center).transpose() / scale;
-    for (int a = 0; a < 3; ++a) {
-      modes(a, 3 * v + a) = 1.0;
-      const Eigen::Vector3d axis = Eigen::Vector3d::Unit(a);
-      const Eigen::Vector3d velocity = axis.cross(r);
-      modes.block(3 + a, 3 * v, 1, 3) = velocity.transpose();
-    }
-  }
-  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(modes);
-  std::vector<int> chosen;
-  for (int k = 0; k < 6 && k < 3 * n; ++k) chosen.push_back(static_cast<int>(qr.colsPermutation().indices()[k]));
-  return chosen;
-}
-
 namespace {
 
-/// Velocity of coordinate `c` under rigid mode `mode` (0-2 translations, 3-5 rotations about `center`).
-double mode_velocity(const Eigen::VectorXd& x, const Eigen::Vector3d& center, int c, int mode) {
-  const int axis = c % 3;
-  if (mode < 3) return mode == axis ? 1.0 : 0.0;
-  const Eigen::Vector3d r = x.segment<3>(c - axis) - center;
-  return Eigen::Vector3d::Unit(mode - 3).cross(r)[axis];
+/// The velocities of a point at `r` from the centre under the six rigid modes: columns 0-2 translate
+/// along x, y, z; columns 3-5 rotate about them (velocity e_a x r).
+Eigen::Matrix<double, 3, 6> rigid_mode_velocities(const Eigen::Vector3d& r) {
+  Eigen::Matrix<double, 3, 6> velocities;
+  velocities.leftCols<3>().setIdentity();
+  for (int a = 0; a < 3; ++a) velocities.col(3 + a) = Eigen::Vector3d::Unit(a).cross(r);
+  return velocities;
 }
 
 Eigen::Vector3d centroid(const Eigen::VectorXd& x) {
@@ -43,6 +22,20 @@ Eigen::Vector3d centroid(const Eigen::VectorXd& x) {
 
 }  // namespace
 
+std::vector<int> rigid_support_coordinates(const Positions& positions) {
+  const Eigen::Index n = positions.rows();
+  const Eigen::RowVector3d center = positions.colwise().mean();
+  const double scale = std::max(1e-12, (positions.rowwise() - center).rowwise().norm().maxCoeff());
+  // Rows: 3 translations and 3 rotations (about the centroid, scaled to unit lever arm).
+  Eigen::MatrixXd modes(6, 3 * n);
+  for (Eigen::Index v = 0; v < n; ++v)
+    modes.middleCols<3>(3 * v) = rigid_mode_velocities((positions.row(v) - center).transpose() / scale).transpose();
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(modes);
+  std::vector<int> chosen;
+  for (int k = 0; k < 6 && k < 3 * n; ++k) chosen.push_back(static_cast<int>(qr.colsPermutation().indices()[k]));
+  return chosen;
+}
+
 Eigen::VectorXd without_rigid_motion(const Eigen::VectorXd& x, const Eigen::VectorXd& step) {
   const Eigen::Index n = x.size() / 3;
   if (n == 0) return step;
@@ -50,20 +43,14 @@ Eigen::VectorXd without_rigid_motion(const Eigen::VectorXd& x, const Eigen::Vect
   // Normal equations of the 6 rigid modes: a 6 x 6 Gram matrix, O(#V).
   Eigen::Matrix<double, 6, 6> gram = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 1> projection = Eigen::Matrix<double, 6, 1>::Zero();
-  Eigen::Matrix<double, 3, 6> block;
   for (Eigen::Index v = 0; v < n; ++v) {
-    const Eigen::Vector3d r = x.segment<3>(3 * v) - center;
-    block.leftCols<3>().setIdentity();
-    for (int a = 0; a < 3; ++a) block.col(3 + a) = Eigen::Vector3d::Unit(a).cross(r);
+    const Eigen::Matrix<double, 3, 6> block = rigid_mode_velocities(x.segment<3>(3 * v) - center);
     gram += block.transpose() * block;
     projection += block.transpose() * step.segment<3>(3 * v);
   }
   const Eigen::Matrix<double, 6, 1> motion = gram.ldlt().solve(projection);
   Eigen::VectorXd result = step;
-  for (Eigen::Index v = 0; v < n; ++v) {
-    const Eigen::Vector3d r = x.segment<3>(3 * v) - center;
-    result.segment<3>(3 * v) -= motion.head<3>() + motion.tail<3>().cross(r);
-  }
+  for (Eigen::Index v = 0; v < n; ++v) result.segment<3>(3 * v) -= rigid_mode_velocities(x.segment<3>(3 * v) - center) * motion;
   return result;
 }
 
@@ -76,8 +63,9 @@ void restore_rigid_support(Eigen::VectorXd& x, const Eigen::VectorXd& held, cons
     Eigen::Matrix<double, 6, 6> jacobian;
     Eigen::Matrix<double, 6, 1> gap;
     for (int i = 0; i < 6; ++i) {
-      gap[i] = held[support[i]] - x[support[i]];
-      for (int mode = 0; mode < 6; ++mode) jacobian(i, mode) = mode_velocity(x, center, support[i], mode);
+      const int c = support[i], axis = c % 3;
+      gap[i] = held[c] - x[c];
+      jacobian.row(i) = rigid_mode_velocities(x.segment<3>(c - axis) - center).row(axis);
     }
     if (gap.norm() <= 1e-13 * (1.0 + held.cwiseAbs().maxCoeff())) return;
     const Eigen::Matrix<double, 6, 1> motion = jacobian.colPivHouseholderQr().solve(gap);
