@@ -135,8 +135,7 @@ Eigen::VectorXd EquilibriumSolver::full_step(const Eigen::VectorXd& x, const Eig
 
 void EquilibriumSolver::return_to_support(Eigen::VectorXd& x, const Eigen::VectorXd& held, double pressure_mpa,
                                           NewtonReport& report) const {
-  if (m_support.empty()) return;
-  restore_rigid_support(x, held, m_support);
+  if (m_support.empty() || !restore_rigid_support(x, held, m_support)) return;
   // The rigid motion leaves |r| unchanged up to the support's reactions, which vanish at equilibrium.
   if (std::isfinite(report.residual_norm)) report.residual_norm = m_assembly.restrict(residual(x, pressure_mpa)).norm();
 }
@@ -413,7 +412,7 @@ int EquilibriumSolver::constrained_descent(Eigen::VectorXd& x, double& pressure_
     if (k == 0 && exact_model) {
       // Second-order correction (the Maratos effect): a full step along a soft direction can carry a
       // second-order volume error that the merit rejects although the step is good. Taking the full
-      // step's own volume error back along H^-1 v costs no solve.
+      // step's own volume error back along K^-1 v costs no solve.
       const double full_step_error = m_model.volume(trial) - target_volume;
       const double dq = -full_step_error / vb;
       const Eigen::VectorXd corrected = trial + dq * full_step(x, b);

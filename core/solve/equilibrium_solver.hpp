@@ -103,12 +103,12 @@ class EquilibriumSolver {
   int factorizations() const { return m_solver.factorizations(); }
 
   /// The held coordinates are a rigid support (rigid_support_coordinates), not physical supports. Exact
-  /// Newton steps of volume control on a positive definite stiffness then drop their rigid-motion part: against six held coordinates a step
-  /// carries whatever rotation brings them back to place, and a large linearised rotation adds a
-  /// spurious second-order volume and energy that cut the line search short (the trefoil knot's design
-  /// start, silicone: 265 -> 71 Newton steps with the second-order correction of constrained_descent).
-  /// solve_volume then ends with the rigid motion that returns the held coordinates to their values on
-  /// entry.
+  /// Newton steps of volume control on a positive definite stiffness then drop their rigid-motion part:
+  /// against six held coordinates a step carries whatever rotation brings them back to place, and a
+  /// large linearised rotation adds a spurious second-order volume and energy that cut the line search
+  /// short (the trefoil knot's design start, silicone: 265 -> 71 Newton steps with the second-order
+  /// correction of constrained_descent). solve_volume then ends with the rigid motion that returns the
+  /// held coordinates to their values on entry.
   void set_support_is_rigid(bool rigid);
 
   /// Rebuilds the sparsity pattern and forgets the step history after the model's hinges changed

@@ -54,10 +54,11 @@ Eigen::VectorXd without_rigid_motion(const Eigen::VectorXd& x, const Eigen::Vect
   return result;
 }
 
-void restore_rigid_support(Eigen::VectorXd& x, const Eigen::VectorXd& held, const std::vector<int>& support) {
-  if (support.size() != 6) return;
+bool restore_rigid_support(Eigen::VectorXd& x, const Eigen::VectorXd& held, const std::vector<int>& support) {
+  if (support.size() != 6) return false;
   // Newton on the six support equations over (translation, rotation vector); quadratic, so three
   // corrections bring a rigid drift of a few degrees to round-off.
+  bool moved = false;
   for (int pass = 0; pass < 4; ++pass) {
     const Eigen::Vector3d center = centroid(x);
     Eigen::Matrix<double, 6, 6> jacobian;
@@ -67,16 +68,18 @@ void restore_rigid_support(Eigen::VectorXd& x, const Eigen::VectorXd& held, cons
       gap[i] = held[c] - x[c];
       jacobian.row(i) = rigid_mode_velocities(x.segment<3>(c - axis) - center).row(axis);
     }
-    if (gap.norm() <= 1e-13 * (1.0 + held.cwiseAbs().maxCoeff())) return;
+    if (gap.norm() <= 1e-13 * (1.0 + held.cwiseAbs().maxCoeff())) return moved;
     const Eigen::Matrix<double, 6, 1> motion = jacobian.colPivHouseholderQr().solve(gap);
-    if (!motion.allFinite()) return;
+    if (!motion.allFinite()) return moved;
     const Eigen::Vector3d omega = motion.tail<3>();
     const double angle = omega.norm();
     const Eigen::Matrix3d rotation =
         angle > 0 ? Eigen::AngleAxisd(angle, omega / angle).toRotationMatrix() : Eigen::Matrix3d::Identity();
     for (Eigen::Index v = 0; v < x.size() / 3; ++v)
       x.segment<3>(3 * v) = center + rotation * (x.segment<3>(3 * v) - center) + motion.head<3>();
+    moved = true;
   }
+  return moved;
 }
 
 }  // namespace balloon

@@ -19,6 +19,7 @@ Eigen::VectorXd without_rigid_motion(const Eigen::VectorXd& x, const Eigen::Vect
 
 /// Moves `x` (3#V, mm) by a rigid motion (exact rotations) so the coordinates `support` (a rigid
 /// support, above) take the values they have in `held`. A rigid motion of an equilibrium is one.
-void restore_rigid_support(Eigen::VectorXd& x, const Eigen::VectorXd& held, const std::vector<int>& support);
+/// False if `x` was already there and is unchanged.
+bool restore_rigid_support(Eigen::VectorXd& x, const Eigen::VectorXd& held, const std::vector<int>& support);
 
 }  // namespace balloon
