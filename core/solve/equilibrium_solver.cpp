@@ -388,7 +388,8 @@ int EquilibriumSolver::constrained_descent(Eigen::VectorXd& x, double& pressure_
     return m_model.elastic_energy(y) - trial_pressure * cy + 0.5 * kappa * cy * cy;
   };
   const double slope = (r - dp * v + kappa * c * v).dot(dx);
-  const Eigen::VectorXd step = exact_model ? full_step(x, dx) : m_assembly.extend(dx);
+  const bool floating = exact_model && !m_support.empty();
+  const Eigen::VectorXd step = floating ? full_step(x, dx) : m_assembly.extend(dx);
   const double value = merit(x);
   // Close to a solution the merit's change drowns in the round-off of W; a clear fall of the KKT
   // residual (force and volume, each against its own scale) then decides.
@@ -409,13 +410,13 @@ int EquilibriumSolver::constrained_descent(Eigen::VectorXd& x, double& pressure_
       pressure_mpa = pressure_mpa + t * dp;
       return k;
     }
-    if (k == 0 && exact_model) {
+    if (k == 0 && floating) {
       // Second-order correction (the Maratos effect): a full step along a soft direction can carry a
       // second-order volume error that the merit rejects although the step is good. Taking the full
       // step's own volume error back along K^-1 v costs no solve.
       const double full_step_error = m_model.volume(trial) - target_volume;
       const double dq = -full_step_error / vb;
-      const Eigen::VectorXd corrected = trial + dq * full_step(x, b);
+      const Eigen::VectorXd corrected = trial + dq * full_step(x, b);  // rigid part dropped here too
       const double corrected_value = merit(corrected);
       if ((std::isfinite(corrected_value) && corrected_value <= value + 1e-4 * std::min(0.0, slope)) ||
           kkt_residual(corrected, pressure_mpa + dp + dq) < 0.5 * kkt0) {
