@@ -131,8 +131,7 @@ bool DesignDriver::inflate_start_to_target_volume(const Eigen::VectorXd& rest, D
     return false;
   }
   if (inflated.bending) {
-    m_model.set_bending(true);
-    m_solver.refresh_pattern();
+    set_bending(true);
     result.active_terms.push_back("sheet_bending");
   }
   // Settle on this driver's solver (its pinned coordinates hold the values the equilibrium has).
@@ -178,8 +177,7 @@ bool DesignDriver::resume_from(const DesignCheckpoint& checkpoint, Eigen::Vector
           return true;
         }
         if (m_model.bending() != had_bending) {  // switched on for a state that then did not settle
-          m_model.set_bending(had_bending);
-          m_solver.refresh_pattern();
+          set_bending(had_bending);
         }
       }
       m_model.set_rest_positions(unflatten(rest));
@@ -192,17 +190,20 @@ bool DesignDriver::resume_from(const DesignCheckpoint& checkpoint, Eigen::Vector
   return true;
 }
 
+void DesignDriver::set_bending(bool on) {
+  m_model.set_bending(on);
+  m_solver.refresh_pattern();  // the hinges widen or narrow the stiffness pattern
+}
+
 bool DesignDriver::switch_bending_on(const Eigen::VectorXd& rest, DesignResult& result) {
   if (m_model.bending() || m_options.method != DesignMethod::Adjoint) return false;
   m_model.set_rest_positions(unflatten(rest));
-  m_model.set_bending(true);
-  m_solver.refresh_pattern();
+  set_bending(true);
   Eigen::VectorXd x = m_x;
   double pressure = m_pressure;
   m_last_report = m_solver.solve_volume(x, pressure, m_target_volume, m_settings);
   if (!m_last_report.converged) {
-    m_model.set_bending(false);
-    m_solver.refresh_pattern();
+    set_bending(false);
     return false;
   }
   m_x = x;

@@ -101,6 +101,8 @@ class DesignDriver {
   /// Where that needed the sheet's bending stiffness, the design keeps it on (adjoint method; listed as
   /// the active term "sheet_bending").
   bool inflate_start_to_target_volume(const Eigen::VectorXd& rest, DesignResult& result);
+  /// The sheet's bending on or off in the model, and the solver's pattern to match.
+  void set_bending(bool on);
 
   const TriMesh& m_target;
   const DesignOptions& m_options;

@@ -128,11 +128,6 @@ void EquilibriumSolver::set_support_is_rigid(bool rigid) {
     if (m_assembly.free_index(c) < 0) m_support.push_back(c);
 }
 
-Eigen::VectorXd EquilibriumSolver::full_step(const Eigen::VectorXd& x, const Eigen::VectorXd& free_step) const {
-  Eigen::VectorXd step = m_assembly.extend(free_step);
-  return m_support.empty() ? step : without_rigid_motion(x, step);
-}
-
 void EquilibriumSolver::return_to_support(Eigen::VectorXd& x, const Eigen::VectorXd& held, double pressure_mpa,
                                           NewtonReport& report) const {
   if (m_support.empty() || !restore_rigid_support(x, held, m_support)) return;
@@ -142,7 +137,7 @@ void EquilibriumSolver::return_to_support(Eigen::VectorXd& x, const Eigen::Vecto
 
 NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
                                              const NewtonSettings& settings) {
-  const Eigen::VectorXd held = x;
+  const Eigen::VectorXd held = m_support.empty() ? Eigen::VectorXd() : x;  // only a rigid support returns
   NewtonReport report = newton_volume(x, pressure_mpa, target_volume, settings);
   return_to_support(x, held, pressure_mpa, report);
   return report;
@@ -389,7 +384,8 @@ int EquilibriumSolver::constrained_descent(Eigen::VectorXd& x, double& pressure_
   };
   const double slope = (r - dp * v + kappa * c * v).dot(dx);
   const bool floating = exact_model && !m_support.empty();
-  const Eigen::VectorXd step = floating ? full_step(x, dx) : m_assembly.extend(dx);
+  Eigen::VectorXd step = m_assembly.extend(dx);
+  if (floating) step = without_rigid_motion(x, step);
   const double value = merit(x);
   // Close to a solution the merit's change drowns in the round-off of W; a clear fall of the KKT
   // residual (force and volume, each against its own scale) then decides.
@@ -416,7 +412,7 @@ int EquilibriumSolver::constrained_descent(Eigen::VectorXd& x, double& pressure_
       // step's own volume error back along K^-1 v costs no solve.
       const double full_step_error = m_model.volume(trial) - target_volume;
       const double dq = -full_step_error / vb;
-      const Eigen::VectorXd corrected = trial + dq * full_step(x, b);  // rigid part dropped here too
+      const Eigen::VectorXd corrected = trial + dq * without_rigid_motion(x, m_assembly.extend(b));
       const double corrected_value = merit(corrected);
       if ((std::isfinite(corrected_value) && corrected_value <= value + 1e-4 * std::min(0.0, slope)) ||
           kkt_residual(corrected, pressure_mpa + dp + dq) < 0.5 * kkt0) {

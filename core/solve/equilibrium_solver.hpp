@@ -137,8 +137,6 @@ class EquilibriumSolver {
   /// pinned support the correction cost latex designs iterations (teddy 5.1x -> 3.7x, spot 6.9x -> 6.0x).
   int constrained_descent(Eigen::VectorXd& x, double& pressure_mpa, double target_volume, const Eigen::VectorXd& v,
                           const Eigen::VectorXd& r, double c, bool exact_model);
-  /// A step over the free coordinates as a step of all of them (see set_support_is_rigid).
-  Eigen::VectorXd full_step(const Eigen::VectorXd& x, const Eigen::VectorXd& free_step) const;
   NewtonReport newton_volume(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
                              const NewtonSettings& settings);
   /// After a solve on a rigid support: back to the held values, and the residual measured there.
