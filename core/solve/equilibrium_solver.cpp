@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "solve/rigid_modes.hpp"
 
@@ -41,6 +42,7 @@ const char* newton_stop_word(NewtonStop stop) {
     case NewtonStop::NonFinite: return "non_finite";
     case NewtonStop::Cancelled: return "cancelled";
     case NewtonStop::TimeLimit: return "time_limit";
+    case NewtonStop::Slow: return "slow";
   }
   return "unknown";
 }
@@ -212,6 +214,7 @@ NewtonReport EquilibriumSolver::newton_volume(Eigen::VectorXd& x, double& pressu
     const double value = std::pow(rn / force_tolerance, 2) + std::pow(c / volume_tolerance, 2);
     return std::isfinite(value) ? value : std::numeric_limits<double>::infinity();
   };
+  std::vector<double> scaled_residuals;  // |r| / force tolerance per iteration, for settings.abandon_slow
   for (report.iterations = 0;; ++report.iterations) {
     const Eigen::VectorXd r = m_assembly.restrict(residual(x, pressure_mpa));
     const double c = m_model.volume(x) - target_volume;
@@ -236,6 +239,13 @@ NewtonReport EquilibriumSolver::newton_volume(Eigen::VectorXd& x, double& pressu
       return report;
     }
     if (should_stop(settings, report)) return report;
+    scaled_residuals.push_back(report.residual_norm / force_tolerance);
+    const size_t last = scaled_residuals.size() - 1;
+    if (settings.abandon_slow && last >= 4 && scaled_residuals[last] > 0.5 * scaled_residuals[last - 2]) {
+      report.stop = NewtonStop::Slow;
+      report.message = "converging too slowly";
+      return report;
+    }
     const Eigen::VectorXd v = m_assembly.restrict(m_model.volume_gradient(x));
 
     // Fast path: exact Newton on the KKT system; globalised on the residual norm, for which it is a

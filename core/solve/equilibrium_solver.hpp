@@ -24,6 +24,7 @@ enum class NewtonStop {
   NonFinite,         ///< the residual became NaN or infinite
   Cancelled,         ///< the cancel token fired
   TimeLimit,         ///< the deadline passed
+  Slow,              ///< NewtonSettings::abandon_slow: the residual stopped falling fast enough
 };
 
 /// One word per stop reason ("converged", "iteration_limit", ...), for reports.
@@ -69,6 +70,11 @@ struct NewtonSettings {
   /// result depends on which of two equally converged starts it gets (spot with latex past its pressure
   /// maximum: 8.7x the baseline from the start solved with 1/4, 1.9x from the one solved with 1/2).
   double shift_restart = 0.25;
+  /// Volume control: give up (NewtonStop::Slow) when, after four or more steps, the residual has not
+  /// halved over the last two. For a caller that has a cheaper way on than a slow path to the end: the
+  /// design's trials start a first-order step from their solution, so a trial that converges this slowly
+  /// has stepped into a wrinkling or snapping region, and a shorter step costs less than finishing it.
+  bool abandon_slow = false;
 };
 
 class EquilibriumSolver {

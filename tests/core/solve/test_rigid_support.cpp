@@ -81,8 +81,11 @@ TEST(RigidSupport, AVolumeSolveFloatingOnItReachesThePinnedEquilibrium) {
     double pressure = 0.0;
     const NewtonReport report = solver.solve_volume(x, pressure, target_volume, settings);
     ASSERT_TRUE(report.converged) << report.message;
-    for (size_t c = 0; c < support.size(); ++c)
-      if (support[c]) EXPECT_NEAR(x[static_cast<Eigen::Index>(c)], entry[static_cast<Eigen::Index>(c)], 1e-9);
+    for (size_t c = 0; c < support.size(); ++c) {
+      if (support[c]) {
+        EXPECT_NEAR(x[static_cast<Eigen::Index>(c)], entry[static_cast<Eigen::Index>(c)], 1e-9);
+      }
+    }
     EXPECT_LE(report.residual_norm, settings.relative_tolerance * solver.force_scale(x, pressure));
     solutions[floating] = x;
   }

@@ -1,0 +1,69 @@
+// NewtonSettings::abandon_slow: a volume solve that converges quadratically is left alone, and one that
+// creeps stops early with NewtonStop::Slow instead of running to its iteration limit.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "fem/balloon_model.hpp"
+#include "mesh/icosphere.hpp"
+#include "mesh/mesh_geometry.hpp"
+#include "solve/equilibrium_solver.hpp"
+#include "solve/rigid_modes.hpp"
+
+namespace balloon {
+namespace {
+
+/// A 642-vertex ellipsoid (semi-axes 16, 10, 8 mm).
+TriMesh ellipsoid() {
+  TriMesh mesh = make_icosphere(10.0, 3);
+  for (int v = 0; v < mesh.vertex_count(); ++v) {
+    mesh.vertices(v, 0) *= 1.6;
+    mesh.vertices(v, 2) *= 0.8;
+  }
+  return mesh;
+}
+
+Material silicone() {
+  Material material;
+  material.model = MaterialModel::MooneyRivlin;
+  material.params = {0.18, 0.02, 0.0};
+  return material;
+}
+
+/// Solves the ellipsoid to `ratio` times its volume from `start_scale` times its rest shape.
+NewtonReport solve(double ratio, double start_scale, bool abandon_slow) {
+  const TriMesh mesh = ellipsoid();
+  std::vector<bool> support(static_cast<size_t>(3 * mesh.vertex_count()), false);
+  for (int c : rigid_support_coordinates(mesh.vertices)) support[static_cast<size_t>(c)] = true;
+  fem::BalloonModel model(mesh, silicone(), std::vector<double>(static_cast<size_t>(mesh.face_count()), 0.5));
+  EquilibriumSolver solver(model, support);
+  NewtonSettings settings;
+  settings.relative_tolerance = 1e-8;
+  settings.max_iterations = 200;
+  settings.abandon_slow = abandon_slow;
+  Eigen::VectorXd x = flat(mesh.vertices) * start_scale;
+  double pressure = 0.0;
+  return solver.solve_volume(x, pressure, ratio * enclosed_volume(mesh.vertices, mesh.faces), settings);
+}
+
+TEST(SlowAbandon, AQuadraticSolveIsLeftAlone) {
+  // From the shape scaled to the target volume: a few Newton steps.
+  const NewtonReport report = solve(3.0, std::cbrt(3.0), true);
+  EXPECT_TRUE(report.converged) << report.message;
+  EXPECT_EQ(report.stop, NewtonStop::Converged);
+}
+
+TEST(SlowAbandon, ACreepingSolveStopsEarlyAndSaysSo) {
+  // From the rest shape straight to eight times its volume: a long, damped way.
+  const NewtonReport plain = solve(8.0, 1.0, false);
+  ASSERT_GE(plain.iterations, 8) << "the case is no longer slow: " << plain.message;
+  const NewtonReport abandoned = solve(8.0, 1.0, true);
+  EXPECT_FALSE(abandoned.converged);
+  EXPECT_EQ(abandoned.stop, NewtonStop::Slow);
+  EXPECT_STREQ(newton_stop_word(abandoned.stop), "slow");
+  EXPECT_GE(abandoned.iterations, 4);  // never before the fourth iteration
+  EXPECT_LT(abandoned.iterations, plain.iterations);
+}
+
+}  // namespace
+}  // namespace balloon
