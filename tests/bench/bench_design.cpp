@@ -1,6 +1,6 @@
 // Inverse-design benchmark (issues 4 and 10): per shape and per method (adjoint, alm): vertices, time,
 // iterations, average and maximum error, the baseline error (the downscaled target inflated) and the
-// improvement over it. Writes the error-against-time curves as CSV (one file per shape, material and
+// improvement over it, and the peak memory (MB, and MB per 1,000 vertices). Writes the error-against-time curves as CSV (one file per shape, material and
 // method) and one SVG plot per shape and material into OUT_DIR.
 // Default: the three sample shapes (bunny, spot, blob) at a 100 mm bounding-box diagonal, silicone.
 // --corpus: every mesh in DATA_DIR/meshes at a 150 mm diagonal, silicone and latex, 4000 vertices (the
@@ -26,6 +26,7 @@
 #include "jobs/design_job.hpp"
 #include "material/material.hpp"
 #include "mesh/mesh_io.hpp"
+#include "peak_memory.hpp"
 #include "svg_plot.hpp"
 
 namespace {
@@ -186,9 +187,9 @@ int main(int argc, char** argv) {
   std::printf("inverse design: thickness 0.5 mm, volume ratio %g, %.0f mm bbox diagonal, ~%d vertices, "
               "budget %.0f s per design\n",
               volume_ratio, size_mm, resolution, max_time_s);
-  std::printf("%-22s %-9s %-8s %8s %9s %6s %11s %11s %9s %12s %12s %9s  %s\n", "shape", "material", "method", "vertices",
-              "time_s", "iters", "avg_err_mm", "max_err_mm", "avg_%diag", "base_avg_mm", "base_max_mm", "improve",
-              "status");
+  std::printf("%-22s %-9s %-8s %8s %9s %6s %11s %11s %9s %12s %12s %9s %8s %10s  %s\n", "shape", "material", "method",
+              "vertices", "time_s", "iters", "avg_err_mm", "max_err_mm", "avg_%diag", "base_avg_mm", "base_max_mm",
+              "improve", "peak_MB", "MB/1k_vert", "status");
   std::vector<Run> runs;
   for (const Shape& shape : shapes) {
     auto mesh = balloon::read_mesh(data_dir + "/meshes/" + shape.file);
@@ -221,17 +222,20 @@ int main(int argc, char** argv) {
         options.method = method;
         options.max_time_s = max_time_s;
         options.coarse_vertices = coarse_vertices;
+        balloon::bench::reset_peak_memory();
         runs.push_back({shape.name, material_label, balloon::design_balloon(target->mesh, options)});
+        const double peak_mb = balloon::bench::peak_memory_mb();
         const balloon::DesignResult& r = runs.back().result;
         // A value that was never computed prints as nan, never as 0.
         const auto shown = [](const std::optional<double>& value) {
           return value.value_or(std::numeric_limits<double>::quiet_NaN());
         };
-        std::printf("%-22s %-9s %-8s %8d %9.2f %6d %11.4g %11.4g %9.3f %12.4g %12.4g %8.1fx  %s: %s\n",
+        std::printf("%-22s %-9s %-8s %8d %9.2f %6d %11.4g %11.4g %9.3f %12.4g %12.4g %8.1fx %8.1f %10.2f  %s: %s\n",
                     shape.name.c_str(), material_label.c_str(), method_name.c_str(), r.rest.vertex_count(), r.time_s,
                     r.iterations, shown(r.avg_error_mm), shown(r.max_error_mm), 100.0 * shown(r.avg_error_rel),
                     shown(r.baseline_avg_error_mm), shown(r.baseline_max_error_mm),
-                    shown(r.baseline_avg_error_mm) / shown(r.avg_error_mm), balloon::design_stop_name(r.stop).c_str(),
+                    shown(r.baseline_avg_error_mm) / shown(r.avg_error_mm), peak_mb,
+                    1000.0 * peak_mb / r.rest.vertex_count(), balloon::design_stop_name(r.stop).c_str(),
                     r.message.c_str());
         if (std::find(r.active_terms.begin(), r.active_terms.end(), "sheet_bending") != r.active_terms.end())
           std::printf("%-22s   the sheet's bending was on (the membrane alone wrinkled with no stable state)\n", "");

@@ -3,8 +3,8 @@
 // centroid, as a design start is), with silicone, latex and a Neo-Hookean rubber (mu = 0.3 MPa), each
 // inflated under volume control to ratio 2 and 8 (27 for latex), 0.5 mm thick. Meshes above
 // --resolution * 1.25 vertices are remeshed to --resolution vertices with the design's target
-// preparation (CGAL isotropic remeshing); smaller ones keep their slivers. Prints one line per case and
-// the number of failures: a case fails when the solver neither converges nor says why in physical terms
+// preparation (CGAL isotropic remeshing); smaller ones keep their slivers. Prints one line per case (with
+// the case's peak memory, MB and MB per 1,000 vertices) and the number of failures: a case fails when the solver neither converges nor says why in physical terms
 // (an equilibrium that passes through itself is such an answer: counted apart, not as a failure). --tension-field
 // switches on Pipkin's relaxation (InflationOptions::tension_field, off by default).
 // --bending on|off|auto sets InflationOptions::bending (auto by default: switched on when a volume step fails).
@@ -25,6 +25,7 @@
 #include "mesh/mesh_checks.hpp"
 #include "mesh/mesh_geometry.hpp"
 #include "mesh/mesh_io.hpp"
+#include "peak_memory.hpp"
 #include "solve/inflation.hpp"
 
 namespace {
@@ -110,8 +111,8 @@ int main(int argc, char** argv) {
 
   std::printf("volume-controlled inflation, thickness 0.5 mm, remesh above %d vertices to %d, %g s per case\n",
               resolution * 5 / 4, resolution, max_time_s);
-  std::printf("%-26s %6s %5s %6s %-12s %5s %-5s %4s %7s %7s %8s  %s\n", "mesh", "verts", "size", "form", "material",
-              "ratio", "conv", "bend", "newton", "factors", "time_s", "message");
+  std::printf("%-26s %6s %5s %6s %-12s %5s %-5s %4s %7s %7s %8s %8s %10s  %s\n", "mesh", "verts", "size", "form",
+              "material", "ratio", "conv", "bend", "newton", "factors", "time_s", "peak_MB", "MB/1k_vert", "message");
   std::vector<Failure> failures;
   int passes_through_itself = 0;  // converged, but the surface intersects itself: "self" in the table
   std::vector<double> times;
@@ -159,16 +160,18 @@ int main(int argc, char** argv) {
             options.max_time_s = max_time_s;
             options.tension_field = tension_field;
             options.bending = bending;
+            balloon::bench::reset_peak_memory();
             const balloon::InflationResult result = balloon::inflate(rest, options);
+            const double peak_mb = balloon::bench::peak_memory_mb();
             ++cases;
             times.push_back(result.time_s);
             const char* form = shrink == 1.0 ? "given" : "half";
             const bool physical_answer = result.stop == balloon::InflationStop::PassesThroughItself;
-            std::printf("%-26s %6d %5.0f %6s %-12s %5.0f %-5s %4s %7d %7d %8.2f  %s\n", file.c_str(),
+            std::printf("%-26s %6d %5.0f %6s %-12s %5.0f %-5s %4s %7d %7d %8.2f %8.1f %10.2f  %s\n", file.c_str(),
                         rest.vertex_count(), size, form, m.label.c_str(), ratio,
                         result.converged ? "yes" : physical_answer ? "self" : "NO", result.bending ? "on" : "off",
-                        result.newton_iterations, result.factorizations, result.time_s,
-                        result.converged ? "" : result.message.c_str());
+                        result.newton_iterations, result.factorizations, result.time_s, peak_mb,
+                        1000.0 * peak_mb / rest.vertex_count(), result.converged ? "" : result.message.c_str());
             std::fflush(stdout);
             if (physical_answer) ++passes_through_itself;
             if (!result.converged && !physical_answer) {
