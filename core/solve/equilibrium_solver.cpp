@@ -239,12 +239,14 @@ NewtonReport EquilibriumSolver::newton_volume(Eigen::VectorXd& x, double& pressu
       return report;
     }
     if (should_stop(settings, report)) return report;
-    scaled_residuals.push_back(report.residual_norm / force_tolerance);
-    const size_t last = scaled_residuals.size() - 1;
-    if (settings.abandon_slow && last >= 4 && scaled_residuals[last] > 0.5 * scaled_residuals[last - 2]) {
-      report.stop = NewtonStop::Slow;
-      report.message = "converging too slowly";
-      return report;
+    if (settings.abandon_slow) {
+      scaled_residuals.push_back(report.residual_norm / force_tolerance);
+      const size_t last = scaled_residuals.size() - 1;
+      if (last >= 4 && scaled_residuals[last] > 0.5 * scaled_residuals[last - 2]) {
+        report.stop = NewtonStop::Slow;
+        report.message = "converging too slowly";
+        return report;
+      }
     }
     const Eigen::VectorXd v = m_assembly.restrict(m_model.volume_gradient(x));
 
