@@ -119,6 +119,7 @@ class ReducedSpaceDesign {
       }
       // Gauss-Newton in the reduced space first; L-BFGS where it gives no descent direction.
       const GaussNewtonDirection gauss_newton = gauss_newton_direction(rest, gradient);
+      m_driver.debug_time("gauss-newton direction");
       const bool newton_like = gauss_newton.descent;
       Eigen::VectorXd direction = gauss_newton.direction;
       if (!newton_like) {
@@ -143,6 +144,7 @@ class ReducedSpaceDesign {
       Eigen::VectorXd response;
       double pressure_response = 0.0;
       m_sensitivity.linear_response(direction, response, pressure_response);
+      m_driver.debug_time("linear response");
       bool accepted = false, bending_switched = false;
       Eigen::VectorXd trial_rest, trial_x;
       double trial_pressure = 0.0, trial_objective = 0.0;
