@@ -38,29 +38,38 @@ Store::Store(const std::string& path, StoreOptions options)
     m_database.execute("PRAGMA synchronous = FULL; PRAGMA wal_autocheckpoint = 1000");
     return;
   }
-  m_checkpoint_database = std::make_unique<Database>(path, 5000, Synchronous::Normal);
   if (!m_options.durable) {
     // A short-lived command: closing must not checkpoint (fsyncs at every exit, and a new WAL whose
     // header and folder are synced at the next start). The WAL is read back at the next open instead;
-    // once it has grown, the checkpointer copies it in the background of a later command.
+    // the command that grows it past CHECKPOINT_WAL_BYTES copies it into the database when it closes.
     m_database.keep_wal_on_close();
-    m_checkpoint_database->keep_wal_on_close();
-    struct stat info {};
-    m_checkpoint_due = ::fstat(m_wal_fd, &info) == 0 && info.st_size >= CHECKPOINT_WAL_BYTES;
+    return;
   }
+  m_checkpoint_database = std::make_unique<Database>(path, 5000, Synchronous::Normal);
   m_checkpointer = std::thread([this] { checkpoint_loop(); });
 }
 
 Store::~Store() {
-  {
-    std::lock_guard lock(m_checkpoint_mutex);
-    m_stopping = true;
+  if (m_checkpointer.joinable()) {
+    {
+      std::lock_guard lock(m_checkpoint_mutex);
+      m_stopping = true;
+    }
+    m_checkpoint_wake.notify_all();
+    // A checkpoint under way stops where it is (what it copied stays copied): closing does not wait for it.
+    m_checkpoint_database->interrupt();
+    m_checkpointer.join();
+    m_checkpoint_database.reset();
+  } else if (struct stat info {}; m_wal_fd >= 0 && ::fstat(m_wal_fd, &info) == 0 && info.st_size >= CHECKPOINT_WAL_BYTES) {
+    // A command's store whose WAL has grown: copied in and emptied here, once the command's work is done.
+    // A passive checkpoint in the background of such short commands never finished (each open reads the
+    // WAL back and starts over), so the WAL grew by every command's writes: 19 MB over 30 small jobs.
+    try {
+      m_database.execute("PRAGMA wal_checkpoint(TRUNCATE)");
+    } catch (const DatabaseError&) {
+      // Another command is reading: a later one copies it.
+    }
   }
-  m_checkpoint_wake.notify_all();
-  // A checkpoint under way stops where it is (what it copied stays copied): closing does not wait for it.
-  if (m_checkpoint_database) m_checkpoint_database->interrupt();
-  if (m_checkpointer.joinable()) m_checkpointer.join();
-  m_checkpoint_database.reset();
   if (m_wal_fd >= 0) ::close(m_wal_fd);
 }
 
@@ -101,7 +110,6 @@ void Store::checkpoint_loop() {
   while (!m_stopping) {
     m_checkpoint_wake.wait_for(lock, CHECKPOINT_PERIOD, [this] { return m_stopping || m_checkpoint_due; });
     if (m_stopping) break;
-    if (!m_checkpoint_due && !m_options.durable) continue;  // a command's store: only what open found
     m_checkpoint_due = false;
     struct stat info {};
     if (::fstat(m_wal_fd, &info) != 0 || info.st_size == 0) continue;

@@ -9,6 +9,8 @@
 /// mutex: one fdatasync of the WAL, which concurrent callers share. Checkpoints (copying the WAL into the
 /// database, with their own fsyncs) run on a second connection on a background thread, never under the
 /// mutex. Progress rows and design checkpoints are not synced: a power loss may lose the last of them.
+/// A command's store (not durable) keeps its WAL at close, for the next command to read back, unless the
+/// WAL has grown past a few MB: then it is copied into the database and emptied at close.
 #include <condition_variable>
 #include <cstdint>
 #include <memory>

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -176,6 +177,39 @@ TEST(JobStore, ACommandsStoreKeepsItsWalAtCloseAndTheNextOpenReadsIt) {
     ASSERT_TRUE(result);
     EXPECT_EQ(result->inflated_mesh.size(), 300000u);
   }
+  for (const char* suffix : {"", "-wal", "-shm"}) std::remove((path + suffix).c_str());
+}
+
+TEST(JobStore, ACommandsWalStaysBoundedOverManyCommands) {
+  // Commands keep their WAL at close; one that finds it grown copies it into the database, so a long
+  // series of commands does not grow it (and the work of reading it back at every open) without bound.
+  const std::string path = ::testing::TempDir() + "balloon-store-bounded-" + std::to_string(::getpid()) + ".db";
+  for (const char* suffix : {"", "-wal", "-shm"}) std::remove((path + suffix).c_str());
+  long largest_wal = 0;
+  for (int command = 0; command < 30; ++command) {
+    {
+      Store store(path, StoreOptions{false});
+      JobStore jobs(store);
+      JobRecord job = queued_job(jobs, "j-" + std::to_string(command), "alice");
+      ResultRecord result;
+      result.converged = true;
+      result.rest_mesh = std::string(300000, 'r');
+      result.inflated_mesh = std::string(300000, 'i');
+      ASSERT_TRUE(jobs.mark_running(job.row_id));
+      ASSERT_TRUE(jobs.mark_completed(job.row_id, result));
+    }
+    if (std::FILE* wal = std::fopen((path + "-wal").c_str(), "rb")) {
+      std::fseek(wal, 0, SEEK_END);
+      largest_wal = std::max(largest_wal, std::ftell(wal));
+      std::fclose(wal);
+    }
+  }
+  // 30 commands wrote about 18 MB; the WAL holds at most the checkpoint threshold (4 MB) and one
+  // command's writes beyond it.
+  EXPECT_LT(largest_wal, 6L << 20);
+  Store store(path, StoreOptions{false});
+  JobStore jobs(store);
+  for (int command = 0; command < 30; ++command) EXPECT_TRUE(jobs.find("j-" + std::to_string(command)));
   for (const char* suffix : {"", "-wal", "-shm"}) std::remove((path + suffix).c_str());
 }
 
