@@ -148,22 +148,29 @@ TEST(JobStore, AProgressBatchIsOneWriteAndKeepsItsShapeWithItsRow) {
   EXPECT_EQ(jobs.progress_count(job.row_id), 4) << "an empty batch writes nothing";
 }
 
+/// One CLI command on the store at `path` (not durable): a job run to a result of 600 kB of meshes.
+void command_storing_a_result(const std::string& path, const std::string& job_id) {
+  Store store(path, StoreOptions{false});
+  JobStore jobs(store);
+  JobRecord job = queued_job(jobs, job_id, "alice");
+  ResultRecord result;
+  result.converged = true;
+  result.rest_mesh = std::string(300000, 'r');
+  result.inflated_mesh = std::string(300000, 'i');
+  ASSERT_TRUE(jobs.mark_running(job.row_id));
+  ASSERT_TRUE(jobs.mark_completed(job.row_id, result));
+}
+
+void remove_store_files(const std::string& path) {
+  for (const char* suffix : {"", "-wal", "-shm"}) std::remove((path + suffix).c_str());
+}
+
 TEST(JobStore, ACommandsStoreKeepsItsWalAtCloseAndTheNextOpenReadsIt) {
   // The embedded CLI store neither flushes nor checkpoints at close: what it committed must still be
   // there for the next command (the WAL is read back at open).
   const std::string path = ::testing::TempDir() + "balloon-store-wal-" + std::to_string(::getpid()) + ".db";
-  for (const char* suffix : {"", "-wal", "-shm"}) std::remove((path + suffix).c_str());
-  {
-    Store store(path, StoreOptions{false});
-    JobStore jobs(store);
-    JobRecord job = queued_job(jobs, "j-kept", "alice");
-    ResultRecord result;
-    result.converged = true;
-    result.rest_mesh = std::string(300000, 'r');
-    result.inflated_mesh = std::string(300000, 'i');
-    ASSERT_TRUE(jobs.mark_running(job.row_id));
-    ASSERT_TRUE(jobs.mark_completed(job.row_id, result));
-  }
+  remove_store_files(path);
+  command_storing_a_result(path, "j-kept");
   std::FILE* wal = std::fopen((path + "-wal").c_str(), "rb");
   EXPECT_NE(wal, nullptr) << "the WAL was checkpointed and removed at close";
   if (wal) std::fclose(wal);
@@ -177,40 +184,29 @@ TEST(JobStore, ACommandsStoreKeepsItsWalAtCloseAndTheNextOpenReadsIt) {
     ASSERT_TRUE(result);
     EXPECT_EQ(result->inflated_mesh.size(), 300000u);
   }
-  for (const char* suffix : {"", "-wal", "-shm"}) std::remove((path + suffix).c_str());
+  remove_store_files(path);
 }
 
 TEST(JobStore, ACommandsWalStaysBoundedOverManyCommands) {
-  // Commands keep their WAL at close; one that finds it grown copies it into the database, so a long
-  // series of commands does not grow it (and the work of reading it back at every open) without bound.
+  // Commands keep their WAL at close; the one whose writes take it past 4 MB copies it into the database,
+  // so a long series of commands does not grow it (and the work of reading it back at every open).
   const std::string path = ::testing::TempDir() + "balloon-store-bounded-" + std::to_string(::getpid()) + ".db";
-  for (const char* suffix : {"", "-wal", "-shm"}) std::remove((path + suffix).c_str());
+  remove_store_files(path);
   long largest_wal = 0;
   for (int command = 0; command < 30; ++command) {
-    {
-      Store store(path, StoreOptions{false});
-      JobStore jobs(store);
-      JobRecord job = queued_job(jobs, "j-" + std::to_string(command), "alice");
-      ResultRecord result;
-      result.converged = true;
-      result.rest_mesh = std::string(300000, 'r');
-      result.inflated_mesh = std::string(300000, 'i');
-      ASSERT_TRUE(jobs.mark_running(job.row_id));
-      ASSERT_TRUE(jobs.mark_completed(job.row_id, result));
-    }
+    command_storing_a_result(path, "j-" + std::to_string(command));
     if (std::FILE* wal = std::fopen((path + "-wal").c_str(), "rb")) {
       std::fseek(wal, 0, SEEK_END);
       largest_wal = std::max(largest_wal, std::ftell(wal));
       std::fclose(wal);
     }
   }
-  // 30 commands wrote about 18 MB; the WAL holds at most the checkpoint threshold (4 MB) and one
-  // command's writes beyond it.
+  // 30 commands wrote about 18 MB; the WAL never holds more than the threshold and one command's writes.
   EXPECT_LT(largest_wal, 6L << 20);
   Store store(path, StoreOptions{false});
   JobStore jobs(store);
   for (int command = 0; command < 30; ++command) EXPECT_TRUE(jobs.find("j-" + std::to_string(command)));
-  for (const char* suffix : {"", "-wal", "-shm"}) std::remove((path + suffix).c_str());
+  remove_store_files(path);
 }
 
 }  // namespace
