@@ -60,7 +60,7 @@ Store::~Store() {
     m_checkpoint_database->interrupt();
     m_checkpointer.join();
     m_checkpoint_database.reset();
-  } else if (struct stat info {}; m_wal_fd >= 0 && ::fstat(m_wal_fd, &info) == 0 && info.st_size >= CHECKPOINT_WAL_BYTES) {
+  } else if (wal_bytes() >= CHECKPOINT_WAL_BYTES) {
     // A command's store whose WAL has grown: copied in and emptied here, once the command's work is done.
     // A passive checkpoint in the background of such short commands never finished (each open reads the
     // WAL back and starts over), so the WAL grew by every command's writes: 19 MB over 30 small jobs.
@@ -95,8 +95,7 @@ void Store::sync() {
       m_sync_done.notify_all();
     }
   }
-  struct stat info {};
-  if (::fstat(m_wal_fd, &info) == 0 && info.st_size >= CHECKPOINT_WAL_BYTES) {
+  if (wal_bytes() >= CHECKPOINT_WAL_BYTES) {
     {
       std::lock_guard lock(m_checkpoint_mutex);
       m_checkpoint_due = true;
@@ -105,14 +104,18 @@ void Store::sync() {
   }
 }
 
+off_t Store::wal_bytes() const {
+  struct stat info {};
+  return m_wal_fd >= 0 && ::fstat(m_wal_fd, &info) == 0 ? info.st_size : -1;
+}
+
 void Store::checkpoint_loop() {
   std::unique_lock lock(m_checkpoint_mutex);
   while (!m_stopping) {
     m_checkpoint_wake.wait_for(lock, CHECKPOINT_PERIOD, [this] { return m_stopping || m_checkpoint_due; });
     if (m_stopping) break;
     m_checkpoint_due = false;
-    struct stat info {};
-    if (::fstat(m_wal_fd, &info) != 0 || info.st_size == 0) continue;
+    if (wal_bytes() <= 0) continue;
     lock.unlock();
     try {
       // PASSIVE: copies what no reader still needs, without blocking the writer or the readers.

@@ -11,6 +11,8 @@
 /// mutex. Progress rows and design checkpoints are not synced: a power loss may lose the last of them.
 /// A command's store (not durable) keeps its WAL at close, for the next command to read back, unless the
 /// WAL has grown past a few MB: then it is copied into the database and emptied at close.
+#include <sys/types.h>
+
 #include <condition_variable>
 #include <cstdint>
 #include <memory>
@@ -67,6 +69,8 @@ class Store {
 
  private:
   void checkpoint_loop();
+  /// The WAL file's size in bytes; -1 without one or when it cannot be read.
+  off_t wal_bytes() const;
 
   StoreOptions m_options;
   Database m_database;

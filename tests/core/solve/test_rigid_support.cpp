@@ -5,8 +5,8 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "ellipsoid_fixture.hpp"
 #include "fem/balloon_model.hpp"
-#include "mesh/icosphere.hpp"
 #include "mesh/mesh_geometry.hpp"
 #include "solve/equilibrium_solver.hpp"
 #include "solve/rigid_modes.hpp"
@@ -14,13 +14,9 @@
 namespace balloon {
 namespace {
 
-/// A 642-vertex ellipsoid (semi-axes 16, 10, 8 mm) as a flat vector: no symmetry a rigid mode could hide in.
+/// The fixture's ellipsoid as a flat vector.
 Eigen::VectorXd ellipsoid(TriMesh& mesh) {
-  mesh = make_icosphere(10.0, 3);
-  for (int v = 0; v < mesh.vertex_count(); ++v) {
-    mesh.vertices(v, 0) *= 1.6;
-    mesh.vertices(v, 2) *= 0.8;
-  }
+  mesh = test::ellipsoid();
   return flat(mesh.vertices);
 }
 
@@ -61,9 +57,7 @@ TEST(RigidSupport, ADriftedShapeReturnsToItsSupport) {
 TEST(RigidSupport, AVolumeSolveFloatingOnItReachesThePinnedEquilibrium) {
   TriMesh mesh;
   const Eigen::VectorXd rest = ellipsoid(mesh);
-  Material silicone;
-  silicone.model = MaterialModel::MooneyRivlin;
-  silicone.params = {0.18, 0.02, 0.0};
+  const Material silicone = test::silicone();
   const double target_volume = 3.0 * enclosed_volume(mesh.vertices, mesh.faces);
   std::vector<bool> support(static_cast<size_t>(rest.size()), false);
   for (int c : rigid_support_coordinates(mesh.vertices)) support[static_cast<size_t>(c)] = true;

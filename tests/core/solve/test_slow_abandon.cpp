@@ -4,8 +4,8 @@
 
 #include <cmath>
 
+#include "ellipsoid_fixture.hpp"
 #include "fem/balloon_model.hpp"
-#include "mesh/icosphere.hpp"
 #include "mesh/mesh_geometry.hpp"
 #include "solve/equilibrium_solver.hpp"
 #include "solve/rigid_modes.hpp"
@@ -13,29 +13,12 @@
 namespace balloon {
 namespace {
 
-/// A 642-vertex ellipsoid (semi-axes 16, 10, 8 mm).
-TriMesh ellipsoid() {
-  TriMesh mesh = make_icosphere(10.0, 3);
-  for (int v = 0; v < mesh.vertex_count(); ++v) {
-    mesh.vertices(v, 0) *= 1.6;
-    mesh.vertices(v, 2) *= 0.8;
-  }
-  return mesh;
-}
-
-Material silicone() {
-  Material material;
-  material.model = MaterialModel::MooneyRivlin;
-  material.params = {0.18, 0.02, 0.0};
-  return material;
-}
-
 /// Solves the ellipsoid to `ratio` times its volume from `start_scale` times its rest shape.
 NewtonReport solve(double ratio, double start_scale, bool abandon_slow) {
-  const TriMesh mesh = ellipsoid();
+  const TriMesh mesh = test::ellipsoid();
   std::vector<bool> support(static_cast<size_t>(3 * mesh.vertex_count()), false);
   for (int c : rigid_support_coordinates(mesh.vertices)) support[static_cast<size_t>(c)] = true;
-  fem::BalloonModel model(mesh, silicone(), std::vector<double>(static_cast<size_t>(mesh.face_count()), 0.5));
+  fem::BalloonModel model(mesh, test::silicone(), std::vector<double>(static_cast<size_t>(mesh.face_count()), 0.5));
   EquilibriumSolver solver(model, support);
   NewtonSettings settings;
   settings.relative_tolerance = 1e-8;
