@@ -4,8 +4,10 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <csignal>
 #include <cstdio>
+#include <mutex>
 #include <thread>
 
 #include "cli_output.hpp"
@@ -71,15 +73,19 @@ WatchOutcome watch_job(ServiceConnection& connection, const std::string& job_id,
   balloon::v1::WatchJobRequest request;
   request.set_job_id(job_id);
 
-  std::atomic<bool> done{false};
-  // A blocking Read cannot see a signal: this thread turns Ctrl-C into a cancelled call.
+  // A blocking Read cannot see a signal: this thread turns Ctrl-C into a cancelled call. It looks every
+  // 20 ms, but waits on `stream_ended` so the end of the stream releases it at once (a plain sleep kept
+  // every command waiting up to 20 ms more at its end).
+  std::mutex mutex;
+  std::condition_variable stream_ended;
+  bool done = false;
   std::thread monitor([&] {
-    while (!done.load()) {
+    std::unique_lock<std::mutex> lock(mutex);
+    while (!stream_ended.wait_for(lock, std::chrono::milliseconds(20), [&] { return done; })) {
       if (interrupts.count() > 0) {
         connection.try_cancel(context);
         return;
       }
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
   });
   auto reader = connection.stub().WatchJob(&context, request);
@@ -91,7 +97,11 @@ WatchOutcome watch_job(ServiceConnection& connection, const std::string& job_id,
     on_event(event);
   }
   outcome.status = reader->Finish();
-  done.store(true);
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    done = true;
+  }
+  stream_ended.notify_one();
   monitor.join();
   outcome.interrupted = interrupts.count() > 0;
   return outcome;
