@@ -1,5 +1,6 @@
 #include "solve/sparse_solver.hpp"
 
+#include "solve/blas_kernels.hpp"
 #include "solve/indefinite_factorization.hpp"
 #include "solve/linear_algebra_threads.hpp"
 
@@ -44,7 +45,10 @@ struct SparseSolver::Internals {
   }
 };
 
-SparseSolver::SparseSolver() : m(std::make_unique<Internals>()) { use_one_linear_algebra_thread(); }
+SparseSolver::SparseSolver() : m(std::make_unique<Internals>()) {
+  use_the_cpus_blas_kernels();
+  use_one_linear_algebra_thread();
+}
 SparseSolver::~SparseSolver() = default;
 
 void SparseSolver::set_pattern(int n, const std::vector<int>& column_starts, const std::vector<int>& row_indices) {
