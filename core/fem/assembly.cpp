@@ -11,41 +11,72 @@ TriangleAssembly::TriangleAssembly(const Faces& faces, int vertex_count, const s
   if (static_cast<int>(fixed_coordinate.size()) != 3 * vertex_count)
     throw std::invalid_argument("TriangleAssembly: fixed_coordinate must have 3#V entries");
   number_free_coordinates(fixed_coordinate);
-
-  // Rows of each column: the free coordinates of all vertices sharing a triangle or a hinge, upper part only.
-  std::vector<std::vector<int>> rows_of_column(static_cast<size_t>(m_free_count));
-  auto add_stencil = [&](const int* vertices, int corners) {
-    for (int k = 0; k < 3 * corners; ++k) {
-      const int col = m_free_index[static_cast<size_t>(3 * vertices[k / 3] + k % 3)];
-      if (col < 0) continue;
-      for (int l = 0; l < 3 * corners; ++l) {
-        const int row = m_free_index[static_cast<size_t>(3 * vertices[l / 3] + l % 3)];
-        if (row >= 0 && row <= col) rows_of_column[static_cast<size_t>(col)].push_back(row);
-      }
-    }
-  };
-  for (int f = 0; f < faces.rows(); ++f) add_stencil(&faces(f, 0), 3);
-  for (const auto& hinge : hinges) {
+  for (const auto& hinge : hinges)
     for (int v : hinge)
       if (v < 0 || v >= vertex_count) throw std::invalid_argument("TriangleAssembly: a hinge vertex does not exist");
-    add_stencil(hinge.data(), 4);
-  }
-  set_pattern(rows_of_column);
 
-  // Slot of every stencil entry (l, k), column-major as the element blocks store it; -1 when skipped.
+  // The pattern is built per vertex (those sharing a triangle or a hinge, itself included) and expanded
+  // to coordinates: free indices follow vertex order, so each column's rows come out sorted, with no
+  // per-coordinate lists to sort (at 100k vertices this took 0.32 s of every inflation's set-up).
+  std::vector<std::vector<int>> coupled(static_cast<size_t>(vertex_count));
+  for (int v = 0; v < vertex_count; ++v) coupled[static_cast<size_t>(v)].push_back(v);
+  auto couple = [&](const int* vertices, int corners) {
+    for (int i = 0; i < corners; ++i)
+      for (int j = 0; j < corners; ++j)
+        if (i != j) coupled[static_cast<size_t>(vertices[i])].push_back(vertices[j]);
+  };
+  for (int f = 0; f < faces.rows(); ++f) couple(&faces(f, 0), 3);
+  for (const auto& hinge : hinges) couple(hinge.data(), 4);
+  for (auto& vertices : coupled) {
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  }
+  m_column_starts.assign(static_cast<size_t>(m_free_count) + 1, 0);
+  for (int v = 0; v < vertex_count; ++v) {
+    for (int b = 0; b < 3; ++b) {
+      const int col = m_free_index[static_cast<size_t>(3 * v + b)];
+      if (col < 0) continue;
+      for (int u : coupled[static_cast<size_t>(v)]) {
+        if (u > v) break;  // every row of a later vertex is below the diagonal
+        for (int a = 0; a < 3; ++a) {
+          const int row = m_free_index[static_cast<size_t>(3 * u + a)];
+          if (row >= 0 && row <= col) m_row_indices.push_back(row);
+        }
+      }
+      m_column_starts[static_cast<size_t>(col) + 1] = static_cast<int>(m_row_indices.size());
+    }
+  }
+  m_values.assign(m_row_indices.size(), 0.0);
+  m_diagonal_slots.resize(static_cast<size_t>(m_free_count));
+  for (int c = 0; c < m_free_count; ++c) m_diagonal_slots[static_cast<size_t>(c)] = slot(c, c);
+
+  // Slot of every stencil entry (l, k), column-major as the element blocks store it; -1 when skipped. A
+  // vertex's free rows sit next to each other in a column, so one search per vertex and column finds them.
   auto stencil_slots = [&](const int* vertices, int corners, int* slots) {
     const int n = 3 * corners;
-    for (int k = 0; k < n; ++k) {
-      const int col = m_free_index[static_cast<size_t>(3 * vertices[k / 3] + k % 3)];
-      for (int l = 0; l < n; ++l) {
-        const int row = m_free_index[static_cast<size_t>(3 * vertices[l / 3] + l % 3)];
-        slots[l + n * k] = col >= 0 && row >= 0 && row <= col ? slot(row, col) : -1;
+    for (int j = 0; j < corners; ++j) {
+      for (int b = 0; b < 3; ++b) {
+        const int k = 3 * j + b;
+        const int col = m_free_index[static_cast<size_t>(3 * vertices[j] + b)];
+        for (int i = 0; i < corners; ++i) {
+          int* entry = slots + 3 * i + n * k;
+          int next = -1;
+          for (int a = 0; a < 3; ++a) {
+            const int row = m_free_index[static_cast<size_t>(3 * vertices[i] + a)];
+            if (col < 0 || row < 0 || row > col) {
+              entry[a] = -1;
+              continue;
+            }
+            next = next < 0 ? slot(row, col) : next + 1;
+            entry[a] = next;
+          }
+        }
       }
     }
   };
-  m_element_slots.assign(static_cast<size_t>(faces.rows()) * 81, -1);
+  m_element_slots.resize(static_cast<size_t>(faces.rows()) * 81);
   for (int f = 0; f < faces.rows(); ++f) stencil_slots(&faces(f, 0), 3, &m_element_slots[static_cast<size_t>(f) * 81]);
-  m_hinge_slots.assign(hinges.size() * 144, -1);
+  m_hinge_slots.resize(hinges.size() * 144);
   for (size_t h = 0; h < hinges.size(); ++h) stencil_slots(hinges[h].data(), 4, &m_hinge_slots[h * 144]);
 }
 
