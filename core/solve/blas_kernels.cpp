@@ -1,6 +1,6 @@
 #include "solve/blas_kernels.hpp"
 
-#include <dlfcn.h>
+#include "solve/loaded_function.hpp"
 
 #include <cstdlib>
 #include <cstring>
@@ -9,13 +9,6 @@
 namespace balloon {
 
 namespace {
-
-/// A function of the BLAS CHOLMOD loaded, looked up at run time so that the build does not depend on
-/// which BLAS the system has chosen (as in linear_algebra_threads.cpp).
-template <class Function>
-Function loaded_function(const char* name) {
-  return reinterpret_cast<Function>(dlsym(RTLD_DEFAULT, name));
-}
 
 /// The kernel set this CPU can run best among those OpenBLAS 0.3.21 has for x86-64, or nullptr.
 const char* best_kernels_for_this_cpu() {
@@ -44,7 +37,7 @@ void use_the_cpus_blas_kernels() {
     auto init = loaded_function<void (*)()>("gotoblas_dynamic_init");
     if (kernels == nullptr || quit == nullptr || init == nullptr) return;
     // OpenBLAS's selection reads OPENBLAS_CORETYPE when it runs; quit only forgets the chosen table, and no
-    // BLAS call has run yet (the first SparseSolver calls this), so re-selecting is what loading with the
+    // BLAS call has run yet (this runs before main), so re-selecting is what loading with the
     // variable set does. The variable is removed again: the environment stays as the user left it.
     setenv("OPENBLAS_CORETYPE", kernels, 0);
     quit();
@@ -52,5 +45,14 @@ void use_the_cpus_blas_kernels() {
     unsetenv("OPENBLAS_CORETYPE");
   });
 }
+
+namespace {
+
+// Done before main as well, while the process has one thread: setenv is not safe beside threads that read
+// the environment (gRPC's, the server's workers). SparseSolver's constructor calls it again (a no-op then),
+// which is also what links this file into every program that factorizes.
+[[maybe_unused]] const bool g_kernels_chosen_before_main = (use_the_cpus_blas_kernels(), true);
+
+}  // namespace
 
 }  // namespace balloon

@@ -8,7 +8,8 @@ namespace balloon {
 /// When OpenBLAS chose Prescott although the CPU has AVX-512 (or AVX2 and FMA), re-runs OpenBLAS's own
 /// kernel selection with OPENBLAS_CORETYPE=SkylakeX (or Haswell), exactly as if the user had set it.
 /// Nothing changes when the user set OPENBLAS_CORETYPE, when OpenBLAS knows the CPU, or when the BLAS is
-/// not OpenBLAS. Runs once per process, before the first factorization (SparseSolver's constructor).
+/// not OpenBLAS. Runs once per process: before main (while the process has one thread, since it sets an
+/// environment variable) and, should that not have run, from SparseSolver's constructor.
 void use_the_cpus_blas_kernels();
 
 /// The kernel set OpenBLAS uses ("SkylakeX", "Prescott", ...), or "" when the BLAS is not OpenBLAS.

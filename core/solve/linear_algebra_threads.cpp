@@ -1,22 +1,11 @@
 #include "solve/linear_algebra_threads.hpp"
 
-#include <dlfcn.h>
+#include "solve/loaded_function.hpp"
 
 #include <cstdlib>
 #include <mutex>
 
 namespace balloon {
-
-namespace {
-
-/// A function of a library CHOLMOD loaded (OpenBLAS, libgomp), looked up at run time so that the
-/// build does not depend on which BLAS the system has chosen.
-template <class Function>
-Function loaded_function(const char* name) {
-  return reinterpret_cast<Function>(dlsym(RTLD_DEFAULT, name));
-}
-
-}  // namespace
 
 void use_one_linear_algebra_thread() {
   static std::once_flag blas_once;
