@@ -46,9 +46,7 @@ TriangleAssembly::TriangleAssembly(const Faces& faces, int vertex_count, const s
       m_column_starts[static_cast<size_t>(col) + 1] = static_cast<int>(m_row_indices.size());
     }
   }
-  m_values.assign(m_row_indices.size(), 0.0);
-  m_diagonal_slots.resize(static_cast<size_t>(m_free_count));
-  for (int c = 0; c < m_free_count; ++c) m_diagonal_slots[static_cast<size_t>(c)] = slot(c, c);
+  finish_pattern();
 
   // Slot of every stencil entry (l, k), column-major as the element blocks store it; -1 when skipped. A
   // vertex's free rows sit next to each other in a column, so one search per vertex and column finds them.
@@ -123,6 +121,10 @@ void TriangleAssembly::set_pattern(std::vector<std::vector<int>>& rows_of_column
   }
   m_row_indices.reserve(static_cast<size_t>(m_column_starts.back()));
   for (const auto& rows : rows_of_column) m_row_indices.insert(m_row_indices.end(), rows.begin(), rows.end());
+  finish_pattern();
+}
+
+void TriangleAssembly::finish_pattern() {
   m_values.assign(m_row_indices.size(), 0.0);
   m_diagonal_slots.resize(static_cast<size_t>(m_free_count));
   for (int c = 0; c < m_free_count; ++c) m_diagonal_slots[static_cast<size_t>(c)] = slot(c, c);

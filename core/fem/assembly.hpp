@@ -63,6 +63,8 @@ class TriangleAssembly {
   void number_free_coordinates(const std::vector<bool>& fixed_coordinate);
   /// Compressed columns from each free column's rows (upper part), with every diagonal kept.
   void set_pattern(std::vector<std::vector<int>>& rows_of_column);
+  /// Zero values and the diagonal slots, once the compressed columns are in place.
+  void finish_pattern();
   /// Slot of (row, column) in free numbering, row <= column; -1 when not in the pattern.
   int slot(int row, int column) const;
 

@@ -59,7 +59,7 @@ TEST_P(AdjointSensitivityTest, LinearResponseMatchesCentralDifferences) {
 }
 
 INSTANTIATE_TEST_SUITE_P(MembraneAndBending, AdjointSensitivityTest, ::testing::Bool(),
-                         [](const auto& info) { return info.param ? "WithBending" : "MembraneOnly"; });
+                         [](const auto& case_info) { return case_info.param ? "WithBending" : "MembraneOnly"; });
 
 }  // namespace
 }  // namespace balloon
