@@ -440,7 +440,8 @@ void JobHandler::run_job(std::int64_t row_id) {
   record->attempts += 1;
 
   v1::JobSpec spec;
-  const bool spec_ok = spec.ParseFromString(record->spec);
+  const std::optional<std::string> stored_spec = m_jobs.spec(row_id);
+  const bool spec_ok = stored_spec && spec.ParseFromString(*stored_spec);
   const double time_limit_s = spec.time_limit_s() > 0.0 ? std::min(spec.time_limit_s(), m_options.job_time_limit_s)
                                                         : m_options.job_time_limit_s;
   const std::shared_ptr<ActiveJob> active = m_pool.enter(row_id, record->job_id, record->owner, time_limit_s);

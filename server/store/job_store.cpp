@@ -4,12 +4,14 @@ namespace balloon::store {
 namespace {
 
 constexpr const char* INSERT_JOB =
-    "INSERT INTO jobs (job_id, owner, kind, state, priority, spec, summary, created_ms, request_id) "
-    "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)";
+    "INSERT INTO jobs (job_id, owner, kind, state, priority, summary, created_ms, request_id) "
+    "VALUES (?, ?, ?, ?, ?, ?, ?, ?)";
+constexpr const char* INSERT_SPEC = "INSERT INTO job_specs (job_row, spec) VALUES (?, ?)";
+constexpr const char* SELECT_SPEC = "SELECT spec FROM job_specs WHERE job_row = ?";
 
 // The latest progress row of each job joins in through its maximum id (index progress_job).
 #define JOB_COLUMNS                                                                                     \
-  "jobs.id, jobs.job_id, jobs.owner, jobs.kind, jobs.state, jobs.priority, jobs.spec, jobs.summary, "  \
+  "jobs.id, jobs.job_id, jobs.owner, jobs.kind, jobs.state, jobs.priority, jobs.summary, "              \
   "jobs.error, jobs.converged, jobs.created_ms, jobs.started_ms, jobs.finished_ms, jobs.attempts, "     \
   "p.phase, p.iteration, p.elapsed_s, p.residual_norm, p.pressure_kpa, p.avg_error_mm, p.max_error_mm, " \
   "p.recorded_ms, jobs.request_id "
@@ -68,7 +70,8 @@ constexpr const char* DELETE_FINISHED_BEFORE =
     "DELETE FROM jobs WHERE state IN ('completed', 'failed', 'cancelled') AND finished_ms < ?";
 // length() of a BLOB reads its size, not its bytes.
 constexpr const char* SELECT_STORED_BYTES =
-    "SELECT (SELECT COALESCE(SUM(LENGTH(spec) + LENGTH(summary) + LENGTH(error)), 0) FROM jobs WHERE owner = ?) + "
+    "SELECT (SELECT COALESCE(SUM(LENGTH(summary) + LENGTH(error)), 0) FROM jobs WHERE owner = ?) + "
+    "(SELECT COALESCE(SUM(LENGTH(s.spec)), 0) FROM job_specs AS s JOIN jobs AS j ON j.id = s.job_row WHERE j.owner = ?) + "
     "(SELECT COALESCE(SUM(LENGTH(r.rest_mesh) + LENGTH(r.inflated_mesh) + LENGTH(CAST(r.report_json AS BLOB)) + "
     "COALESCE(LENGTH(r.report), 0) + COALESCE(LENGTH(r.mold_mesh), 0)), 0) "
     " FROM results AS r JOIN jobs AS j ON j.id = r.job_row WHERE j.owner = ?) + "
@@ -87,27 +90,26 @@ JobRecord read_job(const Statement& row) {
   job.kind = row.column_text(3);
   job.state = job_state_from_string(row.column_text(4));
   job.priority = row.column_int(5);
-  job.spec = row.column_blob(6);
-  job.summary = row.column_text(7);
-  job.error = row.column_text(8);
-  job.converged = row.column_int(9) != 0;
-  job.created_ms = row.column_int64(10);
-  job.started_ms = row.column_int64(11);
-  job.finished_ms = row.column_int64(12);
-  job.attempts = row.column_int(13);
-  if (!row.column_is_null(14)) {
+  job.summary = row.column_text(6);
+  job.error = row.column_text(7);
+  job.converged = row.column_int(8) != 0;
+  job.created_ms = row.column_int64(9);
+  job.started_ms = row.column_int64(10);
+  job.finished_ms = row.column_int64(11);
+  job.attempts = row.column_int(12);
+  if (!row.column_is_null(13)) {
     ProgressRecord progress;
-    progress.phase = row.column_text(14);
-    progress.iteration = row.column_int(15);
-    progress.elapsed_s = row.column_double(16);
-    progress.residual_norm = row.column_double(17);
-    progress.pressure_kpa = row.column_double(18);
-    progress.avg_error_mm = row.column_double(19);
-    progress.max_error_mm = row.column_double(20);
-    progress.recorded_ms = row.column_int64(21);
+    progress.phase = row.column_text(13);
+    progress.iteration = row.column_int(14);
+    progress.elapsed_s = row.column_double(15);
+    progress.residual_norm = row.column_double(16);
+    progress.pressure_kpa = row.column_double(17);
+    progress.avg_error_mm = row.column_double(18);
+    progress.max_error_mm = row.column_double(19);
+    progress.recorded_ms = row.column_int64(20);
     job.last_progress = progress;
   }
-  job.request_id = row.column_text(22);
+  job.request_id = row.column_text(21);
   return job;
 }
 
@@ -133,18 +135,22 @@ JobState job_state_from_string(const std::string& text) {
 
 void JobStore::insert(JobRecord& job) {
   return m_store.write_durably([&] {
+    Transaction transaction(m_store.database());
     Statement statement = m_store.database().prepare(INSERT_JOB);
     statement.bind(1, job.job_id)
         .bind(2, job.owner)
         .bind(3, job.kind)
         .bind(4, to_string(job.state))
         .bind(5, job.priority)
-        .bind_blob(6, job.spec)
-        .bind(7, job.summary)
-        .bind(8, job.created_ms)
-        .bind(9, job.request_id);
+        .bind(6, job.summary)
+        .bind(7, job.created_ms)
+        .bind(8, job.request_id);
     statement.run();
     job.row_id = m_store.database().last_insert_id();
+    Statement spec = m_store.database().prepare(INSERT_SPEC);
+    spec.bind(1, job.row_id).bind_blob(2, job.spec);
+    spec.run();
+    transaction.commit();
   });
 }
 
@@ -154,6 +160,14 @@ std::optional<JobRecord> JobStore::find(const std::string& job_id) {
   statement.bind(1, job_id);
   if (!statement.step()) return std::nullopt;
   return read_job(statement);
+}
+
+std::optional<std::string> JobStore::spec(std::int64_t row_id) {
+  std::lock_guard lock(m_store.mutex());
+  Statement statement = m_store.database().prepare(SELECT_SPEC);
+  statement.bind(1, row_id);
+  if (!statement.step()) return std::nullopt;
+  return statement.column_blob(0);
 }
 
 std::optional<JobRecord> JobStore::find_row(std::int64_t row_id) {
@@ -324,7 +338,7 @@ int JobStore::delete_finished_before(std::int64_t cutoff_ms) {
 std::int64_t JobStore::stored_bytes(const std::string& owner) {
   std::lock_guard lock(m_store.mutex());
   Statement statement = m_store.database().prepare(SELECT_STORED_BYTES);
-  statement.bind(1, owner).bind(2, owner).bind(3, owner);
+  statement.bind(1, owner).bind(2, owner).bind(3, owner).bind(4, owner);
   return statement.step() ? statement.column_int64(0) : 0;
 }
 

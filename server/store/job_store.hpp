@@ -43,7 +43,8 @@ struct JobRecord {
   std::string kind;            ///< "simulate", "design", "fit_material"
   JobState state = JobState::Queued;
   int priority = 0;
-  std::string spec;            ///< the serialized job specification (opaque here)
+  std::string spec;            ///< the serialized job specification (opaque here): written by insert();
+                               ///< queries leave it empty (JobStore::spec reads it, when the job runs)
   std::string summary;         ///< one human line describing the spec
   std::string error;
   bool converged = false;
@@ -82,6 +83,9 @@ class JobStore {
   std::optional<JobRecord> find(const std::string& job_id);
   /// The job with this row id.
   std::optional<JobRecord> find_row(std::int64_t row_id);
+  /// The job's serialized spec, kept apart from its row (it holds the uploaded mesh); nullopt when the
+  /// job does not exist.
+  std::optional<std::string> spec(std::int64_t row_id);
   /// The owner's newest job submitted with `request_id` at or after `since_ms` (ms since the epoch).
   std::optional<JobRecord> find_request(const std::string& owner, const std::string& request_id, std::int64_t since_ms);
   /// The owner's jobs with row id < before_row (0: from the newest), optionally in one state.

@@ -88,8 +88,20 @@ ALTER TABLE results ADD COLUMN report BLOB;
 ALTER TABLE results ADD COLUMN mold_mesh BLOB;
 )sql";
 
+// Version 5: a job's spec (the whole uploaded mesh, often megabytes) in a table of its own, read only when
+// the job runs. In the jobs row, every state change rewrote it (twice per job: 13 MB through the WAL for
+// a 100k-vertex mesh) and every listing and lookup read it back.
+constexpr const char* MIGRATION_5 = R"sql(
+CREATE TABLE job_specs (
+  job_row INTEGER PRIMARY KEY REFERENCES jobs (id) ON DELETE CASCADE,
+  spec BLOB NOT NULL
+);
+INSERT INTO job_specs (job_row, spec) SELECT id, spec FROM jobs;
+ALTER TABLE jobs DROP COLUMN spec;
+)sql";
+
 const std::vector<const char*>& migrations() {
-  static const std::vector<const char*> list = {MIGRATION_1, MIGRATION_2, MIGRATION_3, MIGRATION_4};
+  static const std::vector<const char*> list = {MIGRATION_1, MIGRATION_2, MIGRATION_3, MIGRATION_4, MIGRATION_5};
   return list;
 }
 
@@ -102,12 +114,13 @@ int user_version(Database& database) {
 
 int current_schema_version() { return static_cast<int>(migrations().size()); }
 
-void migrate(Database& database) {
-  const int target = current_schema_version();
+void migrate(Database& database, int target) {
+  if (target < 0 || target > current_schema_version())
+    throw DatabaseError("no schema version " + std::to_string(target) + " to migrate to");
   int version = user_version(database);
-  if (version > target)
+  if (version > current_schema_version())
     throw DatabaseError("database '" + database.path() + "' has schema version " + std::to_string(version) +
-                        ", newer than this build's " + std::to_string(target));
+                        ", newer than this build's " + std::to_string(current_schema_version()));
   while (version < target) {
     Transaction transaction(database);
     // Re-read inside the write lock: another process may have migrated meanwhile.

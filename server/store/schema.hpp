@@ -8,8 +8,9 @@ class Database;
 /// The schema version this build writes.
 int current_schema_version();
 
-/// Brings the database up to current_schema_version(). Throws DatabaseError if the file is newer than
-/// this build understands (it would not know how to read it).
-void migrate(Database& database);
+/// Brings the database up to `target` (current_schema_version() unless a test builds an older store to
+/// upgrade). Throws DatabaseError if the file is newer than this build understands (it would not know how
+/// to read it).
+void migrate(Database& database, int target = current_schema_version());
 
 }  // namespace balloon::store

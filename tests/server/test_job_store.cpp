@@ -9,7 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "store/database.hpp"
 #include "store/job_store.hpp"
+#include "store/schema.hpp"
 
 namespace balloon::store {
 namespace {
@@ -206,6 +208,45 @@ TEST(JobStore, ACommandsWalStaysBoundedOverManyCommands) {
   Store store(path, StoreOptions{false});
   JobStore jobs(store);
   for (int command = 0; command < 30; ++command) EXPECT_TRUE(jobs.find("j-" + std::to_string(command)));
+  remove_store_files(path);
+}
+
+TEST(JobStore, ASpecIsReadOnlyWhenAskedForAndGoesWithItsJob) {
+  // The spec holds the uploaded mesh: lookups and state changes leave it alone; the runner asks for it.
+  Store store(":memory:");
+  JobStore jobs(store);
+  const JobRecord job = queued_job(jobs, "j-spec", "alice");
+  ASSERT_TRUE(jobs.mark_running(job.row_id));
+  const auto found = jobs.find("j-spec");
+  ASSERT_TRUE(found);
+  EXPECT_TRUE(found->spec.empty()) << "a lookup does not read the spec";
+  EXPECT_EQ(jobs.spec(job.row_id), std::string(1000, 's'));
+  EXPECT_GE(jobs.stored_bytes("alice"), 1000) << "the spec counts towards the owner's bytes";
+  jobs.mark_failed(job.row_id, "x");
+  ASSERT_TRUE(jobs.delete_finished(job.row_id));
+  EXPECT_FALSE(jobs.spec(job.row_id));
+  EXPECT_EQ(jobs.stored_bytes("alice"), 0);
+}
+
+TEST(JobStore, AJobQueuedBeforeSpecsMovedToTheirOwnTableKeepsItsSpec) {
+  // A store written by a build of schema version 4 (the spec in the jobs row), opened by this one.
+  const std::string path = ::testing::TempDir() + "balloon-store-v4-" + std::to_string(::getpid()) + ".db";
+  remove_store_files(path);
+  {
+    Database old_store(path);
+    migrate(old_store, 4);
+    old_store.execute("INSERT INTO jobs (job_id, owner, kind, state, spec, created_ms) "
+                      "VALUES ('j-old', 'alice', 'simulate', 'queued', X'0A0B0C', 1)");
+  }
+  {
+    Store store(path);
+    JobStore jobs(store);
+    const auto found = jobs.find("j-old");
+    ASSERT_TRUE(found);
+    EXPECT_EQ(found->state, JobState::Queued);
+    EXPECT_EQ(jobs.spec(found->row_id), std::string("\x0A\x0B\x0C"));
+    EXPECT_EQ(jobs.recover_unfinished(3).queued.size(), 1u);
+  }
   remove_store_files(path);
 }
 
