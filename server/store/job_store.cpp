@@ -162,9 +162,11 @@ std::optional<JobRecord> JobStore::find(const std::string& job_id) {
   return read_job(statement);
 }
 
-std::optional<std::string> JobStore::spec(std::int64_t row_id) {
+std::optional<std::string> JobStore::spec(std::int64_t row_id) { return blob_of_row(SELECT_SPEC, row_id); }
+
+std::optional<std::string> JobStore::blob_of_row(const char* sql, std::int64_t row_id) {
   std::lock_guard lock(m_store.mutex());
-  Statement statement = m_store.database().prepare(SELECT_SPEC);
+  Statement statement = m_store.database().prepare(sql);
   statement.bind(1, row_id);
   if (!statement.step()) return std::nullopt;
   return statement.column_blob(0);
@@ -289,11 +291,7 @@ void JobStore::append_progress_batch(std::int64_t row_id, const std::vector<Prog
 }
 
 std::optional<std::string> JobStore::latest_shape(std::int64_t row_id) {
-  std::lock_guard lock(m_store.mutex());
-  Statement statement = m_store.database().prepare(SELECT_LATEST_SHAPE);
-  statement.bind(1, row_id);
-  if (!statement.step()) return std::nullopt;
-  return statement.column_blob(0);
+  return blob_of_row(SELECT_LATEST_SHAPE, row_id);
 }
 
 void JobStore::save_design_checkpoint(std::int64_t row_id, int iteration, const std::string& rest_shape) {

@@ -144,6 +144,9 @@ class JobStore {
   Recovery recover_unfinished(int max_attempts);
 
  private:
+  /// The one blob `sql` selects for a job row (its one parameter); nullopt when there is none.
+  std::optional<std::string> blob_of_row(const char* sql, std::int64_t row_id);
+
   Store& m_store;
 };
 
