@@ -31,19 +31,34 @@ TriangleAssembly::TriangleAssembly(const Faces& faces, int vertex_count, const s
     std::sort(vertices.begin(), vertices.end());
     vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
   }
+  // Two passes, counting then filling, so the row indices take exactly their size (grown by push_back,
+  // their spare capacity was 24 MB of the 100k case's peak).
+  auto for_each_row = [&](int v, int col, auto&& visit) {
+    for (int u : coupled[static_cast<size_t>(v)]) {
+      if (u > v) break;  // every row of a later vertex is below the diagonal
+      for (int a = 0; a < 3; ++a) {
+        const int row = m_free_index[static_cast<size_t>(3 * u + a)];
+        if (row >= 0 && row <= col) visit(row);
+      }
+    }
+  };
   m_column_starts.assign(static_cast<size_t>(m_free_count) + 1, 0);
   for (int v = 0; v < vertex_count; ++v) {
     for (int b = 0; b < 3; ++b) {
       const int col = m_free_index[static_cast<size_t>(3 * v + b)];
       if (col < 0) continue;
-      for (int u : coupled[static_cast<size_t>(v)]) {
-        if (u > v) break;  // every row of a later vertex is below the diagonal
-        for (int a = 0; a < 3; ++a) {
-          const int row = m_free_index[static_cast<size_t>(3 * u + a)];
-          if (row >= 0 && row <= col) m_row_indices.push_back(row);
-        }
-      }
-      m_column_starts[static_cast<size_t>(col) + 1] = static_cast<int>(m_row_indices.size());
+      int count = 0;
+      for_each_row(v, col, [&](int) { ++count; });
+      m_column_starts[static_cast<size_t>(col) + 1] = m_column_starts[static_cast<size_t>(col)] + count;
+    }
+  }
+  m_row_indices.resize(static_cast<size_t>(m_column_starts.back()));
+  for (int v = 0; v < vertex_count; ++v) {
+    for (int b = 0; b < 3; ++b) {
+      const int col = m_free_index[static_cast<size_t>(3 * v + b)];
+      if (col < 0) continue;
+      int next = m_column_starts[static_cast<size_t>(col)];
+      for_each_row(v, col, [&](int row) { m_row_indices[static_cast<size_t>(next++)] = row; });
     }
   }
   finish_pattern();
