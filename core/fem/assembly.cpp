@@ -15,11 +15,8 @@ TriangleAssembly::TriangleAssembly(const Faces& faces, int vertex_count, const s
     for (int v : hinge)
       if (v < 0 || v >= vertex_count) throw std::invalid_argument("TriangleAssembly: a hinge vertex does not exist");
 
-  // The pattern is built per vertex (those sharing a triangle or a hinge, itself included) and expanded
-  // to coordinates: free indices follow vertex order, so each column's rows come out sorted, with no
-  // per-coordinate lists to sort (at 100k vertices this took 0.32 s of every inflation's set-up).
+  // Vertices coupled by a triangle or a hinge.
   std::vector<std::vector<int>> coupled(static_cast<size_t>(vertex_count));
-  for (int v = 0; v < vertex_count; ++v) coupled[static_cast<size_t>(v)].push_back(v);
   auto couple = [&](const int* vertices, int corners) {
     for (int i = 0; i < corners; ++i)
       for (int j = 0; j < corners; ++j)
@@ -27,41 +24,7 @@ TriangleAssembly::TriangleAssembly(const Faces& faces, int vertex_count, const s
   };
   for (int f = 0; f < faces.rows(); ++f) couple(&faces(f, 0), 3);
   for (const auto& hinge : hinges) couple(hinge.data(), 4);
-  for (auto& vertices : coupled) {
-    std::sort(vertices.begin(), vertices.end());
-    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
-  }
-  // Two passes, counting then filling, so the row indices take exactly their size (grown by push_back,
-  // their spare capacity was 24 MB of the 100k case's peak).
-  auto for_each_row = [&](int v, int col, auto&& visit) {
-    for (int u : coupled[static_cast<size_t>(v)]) {
-      if (u > v) break;  // every row of a later vertex is below the diagonal
-      for (int a = 0; a < 3; ++a) {
-        const int row = m_free_index[static_cast<size_t>(3 * u + a)];
-        if (row >= 0 && row <= col) visit(row);
-      }
-    }
-  };
-  m_column_starts.assign(static_cast<size_t>(m_free_count) + 1, 0);
-  for (int v = 0; v < vertex_count; ++v) {
-    for (int b = 0; b < 3; ++b) {
-      const int col = m_free_index[static_cast<size_t>(3 * v + b)];
-      if (col < 0) continue;
-      int count = 0;
-      for_each_row(v, col, [&](int) { ++count; });
-      m_column_starts[static_cast<size_t>(col) + 1] = m_column_starts[static_cast<size_t>(col)] + count;
-    }
-  }
-  m_row_indices.resize(static_cast<size_t>(m_column_starts.back()));
-  for (int v = 0; v < vertex_count; ++v) {
-    for (int b = 0; b < 3; ++b) {
-      const int col = m_free_index[static_cast<size_t>(3 * v + b)];
-      if (col < 0) continue;
-      int next = m_column_starts[static_cast<size_t>(col)];
-      for_each_row(v, col, [&](int row) { m_row_indices[static_cast<size_t>(next++)] = row; });
-    }
-  }
-  finish_pattern();
+  set_pattern(coupled);
 
   // Slot of every stencil entry (l, k), column-major as the element blocks store it; -1 when skipped. A
   // vertex's free rows sit next to each other in a column, so one search per vertex and column finds them.
@@ -98,20 +61,13 @@ TriangleAssembly::TriangleAssembly(const std::vector<std::vector<int>>& vertex_g
   if (static_cast<int>(fixed_coordinate.size()) != 3 * vertex_count)
     throw std::invalid_argument("TriangleAssembly: fixed_coordinate must have 3#V entries");
   number_free_coordinates(fixed_coordinate);
-  std::vector<std::vector<int>> rows_of_column(static_cast<size_t>(m_free_count));
-  std::vector<int> free_coordinates;
+  std::vector<std::vector<int>> coupled(static_cast<size_t>(vertex_count));
   for (const auto& group : vertex_groups) {
-    free_coordinates.clear();
-    for (int v : group) {
+    for (int v : group)
       if (v < 0 || v >= vertex_count) throw std::invalid_argument("TriangleAssembly: a group vertex does not exist");
-      for (int a = 0; a < 3; ++a)
-        if (const int i = m_free_index[static_cast<size_t>(3 * v + a)]; i >= 0) free_coordinates.push_back(i);
-    }
-    for (int col : free_coordinates)
-      for (int row : free_coordinates)
-        if (row <= col) rows_of_column[static_cast<size_t>(col)].push_back(row);
+    for (int v : group) coupled[static_cast<size_t>(v)].insert(coupled[static_cast<size_t>(v)].end(), group.begin(), group.end());
   }
-  set_pattern(rows_of_column);
+  set_pattern(coupled);
 }
 
 void TriangleAssembly::number_free_coordinates(const std::vector<bool>& fixed_coordinate) {
@@ -125,21 +81,39 @@ void TriangleAssembly::number_free_coordinates(const std::vector<bool>& fixed_co
   }
 }
 
-void TriangleAssembly::set_pattern(std::vector<std::vector<int>>& rows_of_column) {
-  m_column_starts.assign(static_cast<size_t>(m_free_count) + 1, 0);
-  for (int c = 0; c < m_free_count; ++c) {
-    auto& rows = rows_of_column[static_cast<size_t>(c)];
-    rows.push_back(c);  // always keep the diagonal, even for an isolated coordinate
-    std::sort(rows.begin(), rows.end());
-    rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
-    m_column_starts[static_cast<size_t>(c) + 1] = m_column_starts[static_cast<size_t>(c)] + static_cast<int>(rows.size());
+void TriangleAssembly::set_pattern(std::vector<std::vector<int>>& coupled) {
+  // Built per vertex and expanded to its free coordinates: free indices follow vertex order, so each
+  // column's rows come out sorted, with no per-coordinate lists to sort (at 100k vertices those took 0.32 s
+  // of every inflation's set-up). Counted, then filled, so the rows take exactly their size.
+  for (size_t v = 0; v < coupled.size(); ++v) {
+    auto& vertices = coupled[v];
+    vertices.push_back(static_cast<int>(v));  // always keep the diagonal, even for an isolated vertex
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
   }
-  m_row_indices.reserve(static_cast<size_t>(m_column_starts.back()));
-  for (const auto& rows : rows_of_column) m_row_indices.insert(m_row_indices.end(), rows.begin(), rows.end());
-  finish_pattern();
-}
-
-void TriangleAssembly::finish_pattern() {
+  auto for_each_column = [&](auto&& visit) {  // (vertex, free column), in column order
+    for (int v = 0; v < static_cast<int>(coupled.size()); ++v)
+      for (int b = 0; b < 3; ++b)
+        if (const int col = m_free_index[static_cast<size_t>(3 * v + b)]; col >= 0) visit(v, col);
+  };
+  auto for_each_row = [&](int v, int col, auto&& visit) {
+    for (int u : coupled[static_cast<size_t>(v)]) {
+      if (u > v) break;  // every row of a later vertex is below the diagonal
+      for (int a = 0; a < 3; ++a)
+        if (const int row = m_free_index[static_cast<size_t>(3 * u + a)]; row >= 0 && row <= col) visit(row);
+    }
+  };
+  m_column_starts.assign(static_cast<size_t>(m_free_count) + 1, 0);
+  for_each_column([&](int v, int col) {
+    int count = 0;
+    for_each_row(v, col, [&](int) { ++count; });
+    m_column_starts[static_cast<size_t>(col) + 1] = m_column_starts[static_cast<size_t>(col)] + count;
+  });
+  m_row_indices.resize(static_cast<size_t>(m_column_starts.back()));
+  for_each_column([&](int v, int col) {
+    int next = m_column_starts[static_cast<size_t>(col)];
+    for_each_row(v, col, [&](int row) { m_row_indices[static_cast<size_t>(next++)] = row; });
+  });
   m_values.assign(m_row_indices.size(), 0.0);
   m_diagonal_slots.resize(static_cast<size_t>(m_free_count));
   for (int c = 0; c < m_free_count; ++c) m_diagonal_slots[static_cast<size_t>(c)] = slot(c, c);

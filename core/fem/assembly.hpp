@@ -61,10 +61,9 @@ class TriangleAssembly {
  private:
   /// Numbers the free coordinates (m_free_index, m_free_to_coordinate).
   void number_free_coordinates(const std::vector<bool>& fixed_coordinate);
-  /// Compressed columns from each free column's rows (upper part), with every diagonal kept.
-  void set_pattern(std::vector<std::vector<int>>& rows_of_column);
-  /// Zero values and the diagonal slots, once the compressed columns are in place.
-  void finish_pattern();
+  /// Compressed columns (upper part, every diagonal kept), zero values and the diagonal slots, from the
+  /// vertices each vertex couples with (any order, repeats allowed; sorted in place).
+  void set_pattern(std::vector<std::vector<int>>& coupled);
   /// Slot of (row, column) in free numbering, row <= column; -1 when not in the pattern.
   int slot(int row, int column) const;
 
