@@ -46,7 +46,10 @@ std::string triple(int a, int b, int c) { return tuple_of({a, b, c}); }
 /// Union-find with path halving; small and local to the checks.
 class DisjointSets {
  public:
-  explicit DisjointSets(int n) : m_parent(static_cast<std::size_t>(n)) {
+  explicit DisjointSets(int n) { reset(n); }
+  /// n singletons again, keeping the storage (one set per vertex fan, 100k times).
+  void reset(int n) {
+    m_parent.resize(static_cast<std::size_t>(n));
     std::iota(m_parent.begin(), m_parent.end(), 0);
   }
   int find(int i) {
@@ -136,20 +139,32 @@ Result<MeshCheckReport> validate_balloon_mesh(TriMesh& mesh) {
     }
   }
 
-  // Half-edges sorted by undirected edge, then face: each group is one edge with all its faces.
-  std::vector<HalfEdge> half_edges;
-  half_edges.reserve(static_cast<std::size_t>(3 * face_count));
+  // Half-edges sorted by undirected edge, then face: each group is one edge with all its faces. They
+  // are bucketed by the edge's lower vertex first (linear), so only each vertex's few edges are sorted.
+  std::vector<int> bucket_starts(static_cast<std::size_t>(vertex_count) + 1, 0);
   for (int f = 0; f < face_count; ++f) {
     for (int k = 0; k < 3; ++k) {
-      const int from = faces(f, k), to = faces(f, (k + 1) % 3);
-      const auto key = (static_cast<std::uint64_t>(std::min(from, to)) << 32) |
-                       static_cast<std::uint64_t>(std::max(from, to));
-      half_edges.push_back({key, from, to, f});
+      ++bucket_starts[static_cast<std::size_t>(std::min(faces(f, k), faces(f, (k + 1) % 3))) + 1];
     }
   }
-  std::sort(half_edges.begin(), half_edges.end(), [](const HalfEdge& p, const HalfEdge& q) {
-    return p.key != q.key ? p.key < q.key : p.face < q.face;
-  });
+  std::partial_sum(bucket_starts.begin(), bucket_starts.end(), bucket_starts.begin());
+  std::vector<HalfEdge> half_edges(static_cast<std::size_t>(3 * face_count));
+  {
+    std::vector<int> fill(bucket_starts.begin(), bucket_starts.end() - 1);
+    for (int f = 0; f < face_count; ++f) {
+      for (int k = 0; k < 3; ++k) {
+        const int from = faces(f, k), to = faces(f, (k + 1) % 3);
+        const auto key = (static_cast<std::uint64_t>(std::min(from, to)) << 32) |
+                         static_cast<std::uint64_t>(std::max(from, to));
+        half_edges[static_cast<std::size_t>(fill[static_cast<std::size_t>(std::min(from, to))]++)] = {key, from, to, f};
+      }
+    }
+  }
+  for (int v = 0; v < vertex_count; ++v) {
+    std::sort(half_edges.begin() + bucket_starts[static_cast<std::size_t>(v)],
+              half_edges.begin() + bucket_starts[static_cast<std::size_t>(v) + 1],
+              [](const HalfEdge& p, const HalfEdge& q) { return p.key != q.key ? p.key < q.key : p.face < q.face; });
+  }
   std::vector<std::size_t> group_starts;
   for (std::size_t i = 0; i < half_edges.size(); ++i) {
     if (i == 0 || half_edges[i].key != half_edges[i - 1].key) group_starts.push_back(i);
@@ -201,6 +216,14 @@ Result<MeshCheckReport> validate_balloon_mesh(TriMesh& mesh) {
     for (int k = 0; k < 3; ++k) ++fan_offsets[static_cast<std::size_t>(faces(f, k)) + 1];
   }
   std::partial_sum(fan_offsets.begin(), fan_offsets.end(), fan_offsets.begin());
+  for (int v = 0; v < vertex_count; ++v) {
+    const int degree = fan_offsets[static_cast<std::size_t>(v) + 1] - fan_offsets[static_cast<std::size_t>(v)];
+    if (degree > MAX_VERTEX_DEGREE) {
+      return fail("vertex " + str(v) + " has " + str(degree) + " triangles, more than the " +
+                  str(MAX_VERTEX_DEGREE) + " a vertex may have (checking a wider fan for self-intersection " +
+                  "takes minutes); remesh the surface around it");
+    }
+  }
   std::vector<int> fan_faces(static_cast<std::size_t>(3 * face_count));
   {
     std::vector<int> fill(fan_offsets.begin(), fan_offsets.end() - 1);
@@ -208,27 +231,25 @@ Result<MeshCheckReport> validate_balloon_mesh(TriMesh& mesh) {
       for (int k = 0; k < 3; ++k) fan_faces[static_cast<std::size_t>(fill[static_cast<std::size_t>(faces(f, k))]++)] = f;
     }
   }
+  // (neighbour vertex, local face) of every face at a vertex, sorted: faces sharing an edge (v, w) are
+  // neighbours. Sorted rather than searched, so a vertex with 100k faces (a cone's apex) costs
+  // 100k log 100k, not 100k^2 (17 s at submit). Reused per vertex.
+  std::vector<std::pair<int, int>> spokes;
+  DisjointSets fans(0);
   for (int v = 0; v < vertex_count; ++v) {
     const int begin = fan_offsets[static_cast<std::size_t>(v)];
     const int degree = fan_offsets[static_cast<std::size_t>(v) + 1] - begin;
     if (degree == 0) continue;
-    DisjointSets fans(degree);
-    // (neighbour vertex, local face) of the first face seen with edge (v, neighbour).
-    std::vector<std::pair<int, int>> seen;
-    seen.reserve(static_cast<std::size_t>(degree));
+    fans.reset(degree);
+    spokes.clear();
     for (int i = 0; i < degree; ++i) {
       const int f = fan_faces[static_cast<std::size_t>(begin + i)];
-      for (int k = 0; k < 3; ++k) {
-        const int w = faces(f, k);
-        if (w == v) continue;
-        const auto it = std::find_if(seen.begin(), seen.end(), [w](const auto& s) { return s.first == w; });
-        if (it == seen.end()) {
-          seen.emplace_back(w, i);
-        } else {
-          fans.unite(it->second, i);
-        }
-      }
+      for (int k = 0; k < 3; ++k)
+        if (faces(f, k) != v) spokes.emplace_back(faces(f, k), i);
     }
+    std::sort(spokes.begin(), spokes.end());
+    for (std::size_t s = 1; s < spokes.size(); ++s)
+      if (spokes[s].first == spokes[s - 1].first) fans.unite(spokes[s - 1].second, spokes[s].second);
     int fan_count = 0, other_face = -1;
     for (int i = 0; i < degree; ++i) {
       if (fans.find(i) == i) {

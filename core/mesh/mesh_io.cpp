@@ -68,12 +68,13 @@ class LineReader {
   int m_line_number = 0;
 };
 
-/// Whitespace-separated tokens of a line, with everything from `comment` on removed.
-std::vector<std::string_view> tokens_of(std::string_view line, char comment = '#') {
+/// Whitespace-separated tokens of a line, with everything from `comment` on removed, into `tokens`
+/// (reused from line to line: a 100k-vertex file has 300k lines).
+void split_tokens(std::string_view line, std::vector<std::string_view>& tokens, char comment = '#') {
   if (const std::size_t hash = line.find(comment); hash != std::string_view::npos) {
     line = line.substr(0, hash);
   }
-  std::vector<std::string_view> tokens;
+  tokens.clear();
   std::size_t i = 0;
   while (i < line.size()) {
     while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
@@ -81,7 +82,6 @@ std::vector<std::string_view> tokens_of(std::string_view line, char comment = '#
     while (i < line.size() && !std::isspace(static_cast<unsigned char>(line[i]))) ++i;
     if (i > start) tokens.push_back(line.substr(start, i - start));
   }
-  return tokens;
 }
 
 // from_chars is locale-independent and exact, unlike strtod under a foreign LC_NUMERIC. It also reads
@@ -126,12 +126,13 @@ Result<TriMesh> parse_obj(std::string_view text, const MeshReadLimits& limits) {
   LineReader lines(text);
   std::string_view line;
   int face_index = 0;
+  std::vector<std::string_view> tokens;
+  auto where = [&]() { return "line " + std::to_string(lines.line_number()); };
   while (lines.next(line)) {
-    const auto tokens = tokens_of(line);
+    split_tokens(line, tokens);
     if (tokens.empty()) continue;
-    const std::string where = "line " + std::to_string(lines.line_number());
     if (tokens[0] == "v") {
-      if (tokens.size() < 4) return fail(where + ": a vertex needs 3 coordinates");
+      if (tokens.size() < 4) return fail(where() + ": a vertex needs 3 coordinates");
       if (const std::string over = over_limit_message(static_cast<std::int64_t>(coordinates.size() / 3) + 1,
                                                       limits.max_vertices, "vertices");
           !over.empty()) {
@@ -140,7 +141,7 @@ Result<TriMesh> parse_obj(std::string_view text, const MeshReadLimits& limits) {
       for (int k = 1; k <= 3; ++k) {
         double value = 0.0;
         if (!parse_double(tokens[static_cast<std::size_t>(k)], value)) {
-          return fail(where + ": bad vertex coordinate " + quoted(tokens[static_cast<std::size_t>(k)]));
+          return fail(where() + ": bad vertex coordinate " + quoted(tokens[static_cast<std::size_t>(k)]));
         }
         coordinates.push_back(value);
       }
@@ -150,7 +151,7 @@ Result<TriMesh> parse_obj(std::string_view text, const MeshReadLimits& limits) {
       }
       const std::size_t corners = tokens.size() - 1;
       if (corners != 3) {
-        return fail("face " + std::to_string(face_index) + " (" + where + ") has " +
+        return fail("face " + std::to_string(face_index) + " (" + where() + ") has " +
                     std::to_string(corners) + " vertices; only triangles are supported");
       }
       const long vertex_count = static_cast<long>(coordinates.size() / 3);
@@ -159,13 +160,13 @@ Result<TriMesh> parse_obj(std::string_view text, const MeshReadLimits& limits) {
         const std::string_view ref = tokens[k].substr(0, tokens[k].find('/'));
         long index = 0;
         if (!parse_long(ref, index) || index == 0) {
-          return fail(where + ": bad vertex reference " + quoted(tokens[k]) + " in face " +
+          return fail(where() + ": bad vertex reference " + quoted(tokens[k]) + " in face " +
                       std::to_string(face_index));
         }
         // Negative references count back from the last vertex read so far.
         const long zero_based = index > 0 ? index - 1 : vertex_count + index;
         if (zero_based < 0 || zero_based >= vertex_count) {
-          return fail("face " + std::to_string(face_index) + " (" + where + ") refers to vertex " +
+          return fail("face " + std::to_string(face_index) + " (" + where() + ") refers to vertex " +
                       std::to_string(index) + " but only " + std::to_string(vertex_count) +
                       " vertices precede it");
         }
@@ -186,7 +187,7 @@ Result<TriMesh> parse_off(std::string_view text, const MeshReadLimits& limits) {
   // Next line with content; false at the end of the text.
   auto next_tokens = [&]() {
     while (lines.next(line)) {
-      tokens = tokens_of(line);
+      split_tokens(line, tokens);
       if (!tokens.empty()) return true;
     }
     return false;
@@ -332,8 +333,14 @@ std::string obj_bytes(const TriMesh& mesh) {
     out += '\n';
   }
   for (int f = 0; f < mesh.face_count(); ++f) {
-    out += "f " + std::to_string(mesh.faces(f, 0) + 1) + ' ' + std::to_string(mesh.faces(f, 1) + 1) + ' ' +
-           std::to_string(mesh.faces(f, 2) + 1) + '\n';
+    out += 'f';
+    for (int k = 0; k < 3; ++k) {
+      char buffer[16];
+      buffer[0] = ' ';
+      const auto end = std::to_chars(buffer + 1, buffer + sizeof buffer, mesh.faces(f, k) + 1).ptr;
+      out.append(buffer, end);
+    }
+    out += '\n';
   }
   return out;
 }

@@ -212,6 +212,34 @@ TEST(MeshChecks, RejectsNonManifoldVertex) {
   expect_rejected(both, {"non-manifold vertex " + std::to_string(touching_a), "2 separate fans"});
 }
 
+/// A double cone: apex 0 above, apex 1 below, `slices` rim vertices; each apex has `slices` triangles.
+TriMesh double_cone(int slices) {
+  TriMesh mesh;
+  mesh.vertices.resize(slices + 2, 3);
+  mesh.vertices.row(0) << 0.0, 0.0, 50.0;
+  mesh.vertices.row(1) << 0.0, 0.0, -50.0;
+  for (int i = 0; i < slices; ++i) {
+    const double angle = 2.0 * M_PI * i / slices;
+    mesh.vertices.row(i + 2) << 50.0 * std::cos(angle), 50.0 * std::sin(angle), 0.0;
+  }
+  mesh.faces.resize(2 * slices, 3);
+  for (int i = 0; i < slices; ++i) {
+    const int a = i + 2, b = (i + 1) % slices + 2;
+    mesh.faces.row(2 * i) << 0, a, b;
+    mesh.faces.row(2 * i + 1) << 1, b, a;
+  }
+  return mesh;
+}
+
+TEST(MeshChecks, AVertexMayHaveAtMostTheDegreeLimitOfTriangles) {
+  TriMesh widest = double_cone(MAX_VERTEX_DEGREE);
+  const auto report = validate_balloon_mesh(widest);
+  ASSERT_TRUE(report.ok()) << report.error();
+  EXPECT_EQ(report->genus, 0);
+  expect_rejected(double_cone(MAX_VERTEX_DEGREE + 1),
+                  {"vertex 0 has " + std::to_string(MAX_VERTEX_DEGREE + 1) + " triangles", "remesh"});
+}
+
 TEST(MeshChecks, RejectsSeveralComponents) {
   const TriMesh a = make_icosphere(10.0, 1);
   TriMesh b = make_icosphere(5.0, 1);
