@@ -6,12 +6,22 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "solve/rigid_modes.hpp"
 
 namespace balloon {
+
 namespace {
+/// A residual up to this multiple of its measured rounding level is rounding (the measure is the
+/// difference of two evaluations' errors, so it scatters about them by a factor of about 2).
+constexpr double ROUNDING_MARGIN = 3.0;
+/// Never accept a floor above this fraction of the force scale: an equilibrium so blurred is not one.
+constexpr double MAX_ROUNDING_FLOOR = 1e-5;
+/// With the residual at its floor, the volume counts as met within this fraction of the target (a sum of
+/// #F terms, so about a thousand roundings of it), should the tolerance ask for more.
+constexpr double VOLUME_ROUNDING = 1e-12;
 
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -29,6 +39,14 @@ bool should_stop(const NewtonSettings& settings, NewtonReport& report) {
     return true;
   }
   return false;
+}
+
+std::string converged_message(const NewtonReport& report) {
+  if (report.rounding_floor <= 0.0) return "converged";
+  char text[160];
+  std::snprintf(text, sizeof(text), "converged at the residual's rounding floor (%.3g N, at most %.3g N)",
+                report.residual_norm, report.rounding_floor);
+  return text;
 }
 
 }  // namespace
@@ -83,6 +101,27 @@ double EquilibriumSolver::force_scale(const Eigen::VectorXd& x, double pressure_
   for (int c = 0; c < v.size(); ++c)
     if (m_assembly.free_index(c) < 0) v[c] = 0.0;
   return std::abs(pressure_mpa) * v.norm() + m_force_floor;
+}
+
+double EquilibriumSolver::residual_rounding(const Eigen::VectorXd& x, double pressure_mpa,
+                                            const Eigen::VectorXd& r) const {
+  const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> points(x.data(), x.size() / 3, 3);
+  const double size = (points.colwise().maxCoeff() - points.colwise().minCoeff()).maxCoeff();
+  // Not along an axis, and of the shape's size: every coordinate's low bits change, none grows much.
+  const Eigen::RowVector3d shift = size * Eigen::RowVector3d(0.31, 0.43, 0.57);
+  Eigen::VectorXd moved = x;
+  for (Eigen::Index v = 0; v < points.rows(); ++v) moved.segment<3>(3 * v) += shift.transpose();
+  return (m_assembly.restrict(residual(moved, pressure_mpa)) - r).norm();
+}
+
+bool EquilibriumSolver::at_rounding_floor(const Eigen::VectorXd& x, double pressure_mpa, const Eigen::VectorXd& r,
+                                          double previous_residual, double force_scale_n, NewtonReport& report) const {
+  const double residual_norm = report.residual_norm;
+  if (report.iterations == 0 || residual_norm <= 0.5 * previous_residual) return false;  // still converging
+  const double floor = ROUNDING_MARGIN * residual_rounding(x, pressure_mpa, r);
+  if (!(residual_norm <= floor && floor <= MAX_ROUNDING_FLOOR * force_scale_n)) return false;
+  report.rounding_floor = floor;
+  return true;
 }
 
 bool EquilibriumSolver::factorize_stiffness(const Eigen::VectorXd& x, double pressure_mpa) {
@@ -148,19 +187,22 @@ NewtonReport EquilibriumSolver::solve_volume(Eigen::VectorXd& x, double& pressur
 NewtonReport EquilibriumSolver::solve_pressure(Eigen::VectorXd& x, double pressure_mpa, const NewtonSettings& settings) {
   NewtonReport report;
   auto total_energy = [&](const Eigen::VectorXd& y) { return m_model.elastic_energy(y) - pressure_mpa * m_model.volume(y); };
+  double previous_residual = std::numeric_limits<double>::infinity();
   for (report.iterations = 0;; ++report.iterations) {
     const Eigen::VectorXd r = m_assembly.restrict(residual(x, pressure_mpa));
     report.residual_norm = r.norm();
-    const double tolerance = settings.relative_tolerance * force_scale(x, pressure_mpa);
+    const double scale = force_scale(x, pressure_mpa);
+    const double tolerance = settings.relative_tolerance * scale;
     if (!std::isfinite(report.residual_norm)) {
       report.stop = NewtonStop::NonFinite;
       report.message = "non-finite residual";
       return report;
     }
-    if (report.residual_norm <= tolerance) {
+    if (report.residual_norm <= tolerance ||
+        at_rounding_floor(x, pressure_mpa, r, std::exchange(previous_residual, report.residual_norm), scale, report)) {
       report.converged = true;
       report.stop = NewtonStop::Converged;
-      report.message = "converged";
+      report.message = converged_message(report);
       return report;
     }
     if (report.iterations >= settings.max_iterations) {
@@ -215,22 +257,27 @@ NewtonReport EquilibriumSolver::newton_volume(Eigen::VectorXd& x, double& pressu
     return std::isfinite(value) ? value : std::numeric_limits<double>::infinity();
   };
   std::vector<double> scaled_residuals;  // |r| / force tolerance per iteration, for settings.abandon_slow
+  double previous_residual = std::numeric_limits<double>::infinity();
   for (report.iterations = 0;; ++report.iterations) {
     const Eigen::VectorXd r = m_assembly.restrict(residual(x, pressure_mpa));
     const double c = m_model.volume(x) - target_volume;
     report.residual_norm = r.norm();
     report.volume_error = c;
-    const double force_tolerance = settings.relative_tolerance * force_scale(x, pressure_mpa);
+    const double scale = force_scale(x, pressure_mpa);
+    const double force_tolerance = settings.relative_tolerance * scale;
     if (!std::isfinite(report.residual_norm) || !std::isfinite(c)) {
       report.stop = NewtonStop::NonFinite;
       report.message = "non-finite residual";
       return report;
     }
-    if (report.residual_norm <= force_tolerance && std::abs(c) <= volume_tolerance) {
+    const double previous = std::exchange(previous_residual, report.residual_norm);
+    if ((std::abs(c) <= volume_tolerance && report.residual_norm <= force_tolerance) ||
+        (std::abs(c) <= std::max(volume_tolerance, VOLUME_ROUNDING * std::abs(target_volume)) &&
+         at_rounding_floor(x, pressure_mpa, r, previous, scale, report))) {
       report.unstable_modes = m_last_unstable_modes;
       report.converged = true;
       report.stop = NewtonStop::Converged;
-      report.message = "converged";
+      report.message = converged_message(report);
       return report;
     }
     if (report.iterations >= settings.max_iterations) {

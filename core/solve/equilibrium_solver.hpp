@@ -46,6 +46,8 @@ struct NewtonReport {
   /// stable state there (InflationOptions::bending).
   int exact_factorizations = 0;
   int indefinite_factorizations = 0;
+  /// Converged at the residual's rounding floor (N; see NewtonSettings), 0 when the tolerance itself held.
+  double rounding_floor = 0.0;
 };
 
 /// A failed solve that found the stiffness indefinite at most of its exact factorizations: compressed
@@ -58,6 +60,12 @@ inline bool creeping_through_wrinkles(const NewtonReport& report) {
 /// (G the small-strain shear modulus, h the mean thickness, A the rest area: a thousandth of the membrane
 /// force a unit strain would cause), so the test keeps its meaning near zero pressure; under volume
 /// control also |V - V_target| <= relative_tolerance * V_target.
+///
+/// Slivers (a fan of 0.04-degree triangles, say) can put the residual's own rounding error above that
+/// tolerance: no step can lower it further. So once Newton stagnates (|r| above half the last |r|) with
+/// the volume met, the rounding level of the residual is measured (residual_rounding) and a residual
+/// within ROUNDING_MARGIN of it also counts as converged, reported as NewtonReport::rounding_floor, as
+/// long as that floor is below MAX_ROUNDING_FLOOR * F (and the volume is met, to 1e-12 of it at most).
 struct NewtonSettings {
   double relative_tolerance = 1e-8;  ///< see above
   int max_iterations = 30;
@@ -95,6 +103,10 @@ class EquilibriumSolver {
   Eigen::VectorXd residual(const Eigen::VectorXd& x, double pressure_mpa) const;
   /// Force scale (N) against which residuals are judged.
   double force_scale(const Eigen::VectorXd& x, double pressure_mpa) const;
+  /// Rounding level (N) of the free residual `r` at x: |r(x + t) - r(x)| for a rigid translation t of
+  /// about the shape's size. The residual does not change under translation (W sees only edges, and grad V
+  /// of a closed surface neither), so what does change is the error of evaluating it in floating point.
+  double residual_rounding(const Eigen::VectorXd& x, double pressure_mpa, const Eigen::VectorXd& r) const;
 
   /// Factorizes the exact Hessian of W - p V at x (free coordinates). True if it is positive definite.
   bool factorize_at(const Eigen::VectorXd& x, double pressure_mpa);
@@ -124,6 +136,10 @@ class EquilibriumSolver {
  private:
   /// Factorizes K, or K + shift I with the smallest shift found that makes it positive definite.
   bool factorize_stiffness(const Eigen::VectorXd& x, double pressure_mpa);
+  /// The convergence test's second half (see NewtonSettings): Newton stagnates and |r| is within its
+  /// rounding level. Records the floor in `report`.
+  bool at_rounding_floor(const Eigen::VectorXd& x, double pressure_mpa, const Eigen::VectorXd& r,
+                         double previous_residual, double force_scale_n, NewtonReport& report) const;
 
   /// Negative eigenvalues of the bordered KKT matrix [K v; v^T 0] for the last LDL^T factorization of K
   /// (Haynsworth: the inertia of K plus the sign of -v^T K^-1 v).

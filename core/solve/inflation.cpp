@@ -121,7 +121,7 @@ class InflationRun {
     }
     result.converged = ok;
     result.stop = ok ? InflationStop::Converged : m_stop;
-    if (ok) result.message = "converged";
+    if (ok) result.message = m_final_message;
     fill(result, m_state);
     return result;
   }
@@ -249,6 +249,7 @@ class InflationRun {
     if (m_path_predictor) m_previous = state;
     state = {x, pressure, target_volume};
     m_unstable_modes = report.unstable_modes;
+    m_final_message = report.message;
     ++m_load_steps;
     report_progress(state, report.residual_norm, true);
     return true;
@@ -375,7 +376,8 @@ class InflationRun {
           return false;
         }
         state = {x, target_pressure, m_model.volume(x)};
-            return true;
+        m_final_message = report.message;
+        return true;
       }
       if (report.iterations <= 6) step *= 2.0;
     }
@@ -412,6 +414,7 @@ class InflationRun {
   int m_newton_iterations = 0;
   int m_load_steps = 0;
   int m_unstable_modes = 0;
+  std::string m_final_message = "converged";  ///< the last equilibrium solve's (it may name a rounding floor)
   PathPoint m_unfinished;                   ///< where the last failed attempt ended
   double m_unfinished_start_residual = 0.0;  ///< N, the residual that attempt started from
   InflationStop m_stop = InflationStop::NoEquilibrium;
