@@ -1,8 +1,13 @@
 #pragma once
 /// Test fixtures of the volume solver's tests: an ellipsoid with no symmetry a rigid mode could hide in,
 /// and a silicone-like Mooney-Rivlin rubber.
+#include <vector>
+
+#include "fem/balloon_model.hpp"
 #include "material/material.hpp"
 #include "mesh/icosphere.hpp"
+#include "solve/equilibrium_solver.hpp"
+#include "solve/rigid_modes.hpp"
 
 namespace balloon::test {
 
@@ -23,5 +28,18 @@ inline Material silicone() {
   material.params = {0.18, 0.02, 0.0};
   return material;
 }
+
+/// The ellipsoid in silicone 0.5 mm thick, and a volume solver holding its six rigid-support coordinates.
+struct EllipsoidSolve {
+  static std::vector<bool> support_of(const TriMesh& mesh) {
+    std::vector<bool> support(static_cast<size_t>(3 * mesh.vertex_count()), false);
+    for (int c : rigid_support_coordinates(mesh.vertices)) support[static_cast<size_t>(c)] = true;
+    return support;
+  }
+
+  TriMesh mesh = ellipsoid();
+  fem::BalloonModel model{mesh, silicone(), std::vector<double>(static_cast<size_t>(mesh.face_count()), 0.5)};
+  EquilibriumSolver solver{model, support_of(mesh)};
+};
 
 }  // namespace balloon::test

@@ -6,10 +6,7 @@
 #include <cmath>
 
 #include "ellipsoid_fixture.hpp"
-#include "fem/balloon_model.hpp"
 #include "mesh/mesh_geometry.hpp"
-#include "solve/equilibrium_solver.hpp"
-#include "solve/rigid_modes.hpp"
 
 namespace balloon {
 namespace {
@@ -22,23 +19,20 @@ struct Solved {
 
 /// Solves the ellipsoid to three times its volume, by volume or (at the pressure found) by pressure.
 Solved solve(double relative_tolerance, bool by_pressure) {
-  const TriMesh mesh = test::ellipsoid();
-  std::vector<bool> support(static_cast<size_t>(3 * mesh.vertex_count()), false);
-  for (int c : rigid_support_coordinates(mesh.vertices)) support[static_cast<size_t>(c)] = true;
-  fem::BalloonModel model(mesh, test::silicone(), std::vector<double>(static_cast<size_t>(mesh.face_count()), 0.5));
-  EquilibriumSolver solver(model, support);
+  test::EllipsoidSolve ellipsoid;
+  EquilibriumSolver& solver = ellipsoid.solver;
+  const double target_volume = 3.0 * enclosed_volume(ellipsoid.mesh.vertices, ellipsoid.mesh.faces);
   NewtonSettings settings;
   settings.max_iterations = 60;
-  Eigen::VectorXd x = flat(mesh.vertices) * std::cbrt(3.0);
+  Eigen::VectorXd x = flat(ellipsoid.mesh.vertices) * std::cbrt(3.0);
   double pressure = 0.0;
   Solved solved;
-  solved.report = solver.solve_volume(x, pressure, 3.0 * enclosed_volume(mesh.vertices, mesh.faces), settings);
+  solved.report = solver.solve_volume(x, pressure, target_volume, settings);
+  settings.relative_tolerance = relative_tolerance;
   if (by_pressure) {
-    settings.relative_tolerance = relative_tolerance;
     solved.report = solver.solve_pressure(x, pressure, settings);
-  } else if (relative_tolerance != settings.relative_tolerance) {
-    settings.relative_tolerance = relative_tolerance;
-    solved.report = solver.solve_volume(x, pressure, 3.0 * enclosed_volume(mesh.vertices, mesh.faces), settings);
+  } else {
+    solved.report = solver.solve_volume(x, pressure, target_volume, settings);
   }
   solved.force_scale = solver.force_scale(x, pressure);
   const Eigen::VectorXd r = solver.assembly().restrict(solver.residual(x, pressure));

@@ -5,28 +5,22 @@
 #include <cmath>
 
 #include "ellipsoid_fixture.hpp"
-#include "fem/balloon_model.hpp"
 #include "mesh/mesh_geometry.hpp"
-#include "solve/equilibrium_solver.hpp"
-#include "solve/rigid_modes.hpp"
 
 namespace balloon {
 namespace {
 
 /// Solves the ellipsoid to `ratio` times its volume from `start_scale` times its rest shape.
 NewtonReport solve(double ratio, double start_scale, bool abandon_slow) {
-  const TriMesh mesh = test::ellipsoid();
-  std::vector<bool> support(static_cast<size_t>(3 * mesh.vertex_count()), false);
-  for (int c : rigid_support_coordinates(mesh.vertices)) support[static_cast<size_t>(c)] = true;
-  fem::BalloonModel model(mesh, test::silicone(), std::vector<double>(static_cast<size_t>(mesh.face_count()), 0.5));
-  EquilibriumSolver solver(model, support);
+  test::EllipsoidSolve ellipsoid;
   NewtonSettings settings;
   settings.relative_tolerance = 1e-8;
   settings.max_iterations = 200;
   settings.abandon_slow = abandon_slow;
-  Eigen::VectorXd x = flat(mesh.vertices) * start_scale;
+  Eigen::VectorXd x = flat(ellipsoid.mesh.vertices) * start_scale;
   double pressure = 0.0;
-  return solver.solve_volume(x, pressure, ratio * enclosed_volume(mesh.vertices, mesh.faces), settings);
+  return ellipsoid.solver.solve_volume(x, pressure, ratio * enclosed_volume(ellipsoid.mesh.vertices, ellipsoid.mesh.faces),
+                                       settings);
 }
 
 TEST(SlowAbandon, AQuadraticSolveIsLeftAlone) {
