@@ -141,11 +141,12 @@ Result<MeshCheckReport> validate_balloon_mesh(TriMesh& mesh) {
 
   // Half-edges sorted by undirected edge, then face: each group is one edge with all its faces. They
   // are bucketed by the edge's lower vertex first (linear), so only each vertex's few edges are sorted.
+  auto lower_vertex = [&](int f, int k) {
+    return static_cast<std::size_t>(std::min(faces(f, k), faces(f, (k + 1) % 3)));
+  };
   std::vector<int> bucket_starts(static_cast<std::size_t>(vertex_count) + 1, 0);
   for (int f = 0; f < face_count; ++f) {
-    for (int k = 0; k < 3; ++k) {
-      ++bucket_starts[static_cast<std::size_t>(std::min(faces(f, k), faces(f, (k + 1) % 3))) + 1];
-    }
+    for (int k = 0; k < 3; ++k) ++bucket_starts[lower_vertex(f, k) + 1];
   }
   std::partial_sum(bucket_starts.begin(), bucket_starts.end(), bucket_starts.begin());
   std::vector<HalfEdge> half_edges(static_cast<std::size_t>(3 * face_count));
@@ -156,7 +157,7 @@ Result<MeshCheckReport> validate_balloon_mesh(TriMesh& mesh) {
         const int from = faces(f, k), to = faces(f, (k + 1) % 3);
         const auto key = (static_cast<std::uint64_t>(std::min(from, to)) << 32) |
                          static_cast<std::uint64_t>(std::max(from, to));
-        half_edges[static_cast<std::size_t>(fill[static_cast<std::size_t>(std::min(from, to))]++)] = {key, from, to, f};
+        half_edges[static_cast<std::size_t>(fill[lower_vertex(f, k)]++)] = {key, from, to, f};
       }
     }
   }
@@ -216,14 +217,6 @@ Result<MeshCheckReport> validate_balloon_mesh(TriMesh& mesh) {
     for (int k = 0; k < 3; ++k) ++fan_offsets[static_cast<std::size_t>(faces(f, k)) + 1];
   }
   std::partial_sum(fan_offsets.begin(), fan_offsets.end(), fan_offsets.begin());
-  for (int v = 0; v < vertex_count; ++v) {
-    const int degree = fan_offsets[static_cast<std::size_t>(v) + 1] - fan_offsets[static_cast<std::size_t>(v)];
-    if (degree > MAX_VERTEX_DEGREE) {
-      return fail("vertex " + str(v) + " has " + str(degree) + " triangles, more than the " +
-                  str(MAX_VERTEX_DEGREE) + " a vertex may have (checking a wider fan for self-intersection " +
-                  "takes minutes); remesh the surface around it");
-    }
-  }
   std::vector<int> fan_faces(static_cast<std::size_t>(3 * face_count));
   {
     std::vector<int> fill(fan_offsets.begin(), fan_offsets.end() - 1);
@@ -240,6 +233,11 @@ Result<MeshCheckReport> validate_balloon_mesh(TriMesh& mesh) {
     const int begin = fan_offsets[static_cast<std::size_t>(v)];
     const int degree = fan_offsets[static_cast<std::size_t>(v) + 1] - begin;
     if (degree == 0) continue;
+    if (degree > MAX_VERTEX_DEGREE) {
+      return fail("vertex " + str(v) + " has " + str(degree) + " triangles, more than the " +
+                  str(MAX_VERTEX_DEGREE) + " a vertex may have (checking a wider fan for self-intersection " +
+                  "takes minutes); remesh the surface around it");
+    }
     fans.reset(degree);
     spokes.clear();
     for (int i = 0; i < degree; ++i) {

@@ -34,11 +34,11 @@ inline constexpr int MAX_VERTEX_DEGREE = 2000;
 
 /// Checks that `mesh` (positions in mm) is a valid balloon: non-empty, finite coordinates, face indices
 /// in range, no repeated vertex in a face, no zero-area triangle, every edge shared by exactly two
-/// faces, at most MAX_VERTEX_DEGREE triangles at a vertex, every vertex fan a single cycle, one connected component, consistent orientation, non-zero
-/// volume. On failure returns a one-line message naming the problem and where (vertex, edge or face
-/// indices of the input mesh), and leaves `mesh` unchanged. On success it cleans `mesh` in place:
-/// removes unreferenced vertices and, if the enclosed volume is negative, reverses every face
-/// (report.flipped); the report says what was changed.
+/// faces, at most MAX_VERTEX_DEGREE triangles at a vertex, every vertex fan a single cycle, one connected
+/// component, consistent orientation, non-zero volume. On failure returns a one-line message naming the
+/// problem and where (vertex, edge or face indices of the input mesh), and leaves `mesh` unchanged. On
+/// success it cleans `mesh` in place: removes unreferenced vertices and, if the enclosed volume is
+/// negative, reverses every face (report.flipped); the report says what was changed.
 Result<MeshCheckReport> validate_balloon_mesh(TriMesh& mesh);
 
 }  // namespace balloon

@@ -198,8 +198,8 @@ NewtonReport EquilibriumSolver::solve_pressure(Eigen::VectorXd& x, double pressu
       report.message = "non-finite residual";
       return report;
     }
-    if (report.residual_norm <= tolerance ||
-        at_rounding_floor(x, pressure_mpa, r, std::exchange(previous_residual, report.residual_norm), scale, report)) {
+    const double previous = std::exchange(previous_residual, report.residual_norm);
+    if (report.residual_norm <= tolerance || at_rounding_floor(x, pressure_mpa, r, previous, scale, report)) {
       report.converged = true;
       report.stop = NewtonStop::Converged;
       report.message = converged_message(report);
