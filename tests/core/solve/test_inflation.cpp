@@ -204,8 +204,10 @@ namespace {
 // bench's largest ratio. Blob, cactus (flat), spool (coarse, flat ends) and fandisk (CAD edges) are quick;
 // rotor with Neo-Hookean ended at "no equilibrium at volume ratio 1.03", and dino with latex and the knot
 // at the time limit or at "no equilibrium at 1.55", before volume steps were resumed where they ended.
-// The equilibria of the last three pass through themselves (the rotor's blades, the dinosaur's limbs,
-// the knot's strands): the answer is then that stop reason, with the equilibrium found.
+// The rotor's and the knot's equilibria pass through themselves (blades, strands): the answer is then that
+// stop reason, with the equilibrium found. The dinosaur's membrane equilibrium did too (its limbs); its first
+// volume step creeps through wrinkles, and tried with the sheet's bending (try_bending_early) it reaches an
+// equilibrium that does not.
 struct CorpusCase {
   const char* label;
   const char* file;
@@ -240,7 +242,7 @@ INSTANTIATE_TEST_SUITE_P(
                       CorpusCase{"spool_neo_hookean", "spool.off", "neo-hookean:mu=0.3", 8.0},
                       CorpusCase{"fandisk_silicone", "fandisk.off", "silicone", 8.0},
                       CorpusCase{"rotor_neo_hookean", "rotor_small.off", "neo-hookean:mu=0.3", 8.0, InflationStop::PassesThroughItself},
-                      CorpusCase{"dino_latex", "dino.off", "latex", 27.0, InflationStop::PassesThroughItself},
+                      CorpusCase{"dino_latex", "dino.off", "latex", 27.0},
                       CorpusCase{"knot_silicone", "knot.off", "silicone", 8.0, InflationStop::PassesThroughItself}),
     [](const auto& test_info) { return std::string(test_info.param.label); });
 
@@ -349,6 +351,24 @@ TEST(Inflation, BendingKeepsTheSphereLawAndAutoLeavesItOffWhereTheMembraneConver
     EXPECT_FALSE(automatic.bending);
     EXPECT_NEAR(bent.pressure_kpa, automatic.pressure_kpa, 1e-3 * automatic.pressure_kpa);
   }
+}
+
+TEST(Inflation, AStepThatCreepsThroughWrinklesTriesTheSheetsBendingAtOnce) {
+  // The femur (200 mm, silicone) to ratio 2: as a membrane its first volume step creeps through wrinkles
+  // (its stiffness indefinite at most factorizations); four resumes took 240 Newton steps before bending
+  // went on, 386 in all. Tried with bending after the first failed attempt: 81.
+  auto femur = read_mesh(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/femur.off");
+  ASSERT_TRUE(femur.ok()) << femur.error();
+  femur->vertices *= 200.0 / bounding_box_diagonal(femur->vertices);
+  InflationOptions options;
+  options.material = *parse_material_spec("silicone");
+  options.thickness_mm = 0.5;
+  options.volume_ratio = 2.0;
+  const InflationResult result = inflate(*femur, options);
+  ASSERT_TRUE(result.converged) << result.message;
+  EXPECT_TRUE(result.bending);
+  EXPECT_NEAR(result.volume_ratio, 2.0, 2e-6);
+  EXPECT_LT(result.newton_iterations, 150);
 }
 
 }  // namespace
