@@ -342,6 +342,7 @@ class InflationRun {
     if (m_tried_bending_early || !switch_bending_on()) return false;
     m_tried_bending_early = true;
     const PathPoint membrane_unfinished = m_unfinished;
+    const double membrane_start_residual = m_unfinished_start_residual;
     NewtonReport bent;
     if (volume_step(state, next_volume, bent)) {
       report = bent;
@@ -355,6 +356,7 @@ class InflationRun {
     m_solver.refresh_pattern();
     m_inertia.reset();
     m_unfinished = membrane_unfinished;
+    m_unfinished_start_residual = membrane_start_residual;
     return false;
   }
 
