@@ -334,10 +334,11 @@ class InflationRun {
 
   /// Once per path, the first volume step that creeps through wrinkles as a membrane is tried again with
   /// the sheet's bending on, from where it started. True if that converged (bending then stays on); else
-  /// the sheet is a membrane again, with its unfinished attempt as before, and `report` is the bent
-  /// attempt's only when that was stopped (time limit, cancel). Without it the femur at ratio 2 crept through
-  /// 4 membrane resumes (240 Newton steps) before bending went on; a bent attempt that fails costs the
-  /// anchor and knot, whose membrane paths do reach an answer, one attempt.
+  /// the sheet is a membrane again, with its unfinished attempt as before. `report` becomes the bent
+  /// attempt's when that converged or was stopped (time limit, cancel), and stays the membrane's otherwise.
+  /// Without it the femur at ratio 2 crept through 4 membrane resumes (240 Newton steps) before bending
+  /// went on; a bent attempt that fails costs the anchor and knot, whose membrane paths do reach an
+  /// answer, one attempt.
   bool try_bending_early(PathPoint& state, double next_volume, NewtonReport& report) {
     if (m_tried_bending_early || !switch_bending_on()) return false;
     m_tried_bending_early = true;
