@@ -326,10 +326,15 @@ class InflationRun {
   /// stiffness on for the rest of the path (the hinges widen the solver's pattern). True if it did.
   bool switch_bending_on() {
     if (m_options.bending != BendingUse::Auto || m_model.bending()) return false;
-    m_model.set_bending(true);
+    set_bending(true);
+    return true;
+  }
+
+  /// The hinges widen (or narrow) the solver's pattern, and the inertia's factorization goes with it.
+  void set_bending(bool on) {
+    m_model.set_bending(on);
     m_solver.refresh_pattern();
     m_inertia.reset();
-    return true;
   }
 
   /// Once per path, the first volume step that creeps through wrinkles as a membrane is tried again with
@@ -353,9 +358,7 @@ class InflationRun {
       report = bent;
       return false;
     }
-    m_model.set_bending(false);
-    m_solver.refresh_pattern();
-    m_inertia.reset();
+    set_bending(false);
     m_unfinished = membrane_unfinished;
     m_unfinished_start_residual = membrane_start_residual;
     return false;
