@@ -281,9 +281,10 @@ class InflationRun {
       return false;
     }
     int resumes_left = MAX_RESUMES;
+    bool from_bent_try = false;  // this attempt continues the early bent try (see try_bending_early)
     while (std::abs(target_volume - state.volume) > 1e-14 * target_volume) {
       const double next = std::abs(step) >= std::abs(target_volume - state.volume) ? target_volume : state.volume + step;
-      if (volume_step(state, next, report)) {
+      if (volume_step(state, next, report, from_bent_try ? &m_bent_try_unfinished : nullptr)) {
         if (report.iterations <= 6) step *= 2.0;
         resumes_left = MAX_RESUMES;
         continue;
@@ -310,7 +311,13 @@ class InflationRun {
         message = report.message;
         return false;
       }
-      if (creeping_through_wrinkles(report) && switch_bending_on()) continue;  // the same step, now with a stable state
+      if (creeping_through_wrinkles(report) && switch_bending_on()) {
+        // The same step, now with a stable state: from where the early bent try of this very step ended,
+        // rather than repeating it from the predictor.
+        from_bent_try = m_bent_try_unfinished.x.size() > 0 && m_bent_try_unfinished.volume == next;
+        continue;
+      }
+      from_bent_try = false;
       step *= 0.5;
       if (std::abs(step) < smallest) {
         message = "no equilibrium found at volume ratio " + format_number(next / m_model.volume(flat_rest())) +
@@ -358,6 +365,7 @@ class InflationRun {
       report = bent;
       return false;
     }
+    if (worth_resuming(bent)) m_bent_try_unfinished = m_unfinished;
     set_bending(false);
     m_unfinished = membrane_unfinished;
     m_unfinished_start_residual = membrane_start_residual;
@@ -459,6 +467,7 @@ class InflationRun {
   int m_load_steps = 0;
   int m_unstable_modes = 0;
   bool m_tried_bending_early = false;  ///< see try_bending_early
+  PathPoint m_bent_try_unfinished;     ///< where that try ended, when it was still converging; else empty
   std::string m_final_message = "converged";  ///< the last equilibrium solve's (it may name a rounding floor)
   PathPoint m_unfinished;                   ///< where the last failed attempt ended
   double m_unfinished_start_residual = 0.0;  ///< N, the residual that attempt started from
