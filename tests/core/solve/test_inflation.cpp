@@ -389,5 +389,23 @@ TEST(Inflation, ShiftedStepsPastAPressureMaximumHandOverToTheExactStep) {
   EXPECT_LT(result.newton_iterations, 200);
 }
 
+TEST(Inflation, PastAPressureMaximumTheExactStepDescendsOnTheAugmentedLagrangian) {
+  // The dinosaur (200 mm, Neo-Hookean) to ratio 8, past the law's pressure maximum: its stiffness has a
+  // negative pivot that the volume constraint removes. Line-searched on the residual norm there, the exact
+  // steps led to a membrane equilibrium that passes through itself; on the augmented Lagrangian, as for a
+  // positive definite stiffness, the path reaches one (with the sheet's bending) that does not.
+  auto dino = read_mesh(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/dino.off");
+  ASSERT_TRUE(dino.ok()) << dino.error();
+  dino->vertices *= 200.0 / bounding_box_diagonal(dino->vertices);
+  InflationOptions options;
+  options.material = *parse_material_spec("neo-hookean:mu=0.3");
+  options.thickness_mm = 0.5;
+  options.volume_ratio = 8.0;
+  const InflationResult result = inflate(*dino, options);
+  ASSERT_TRUE(result.converged) << result.message;
+  EXPECT_EQ(result.stop, InflationStop::Converged);
+  EXPECT_NEAR(result.volume_ratio, 8.0, 8.0 * 1e-6);
+}
+
 }  // namespace
 }  // namespace balloon
