@@ -6,6 +6,7 @@
 #include <memory>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "fem/balloon_model.hpp"
 #include "mesh/self_intersection.hpp"
@@ -281,10 +282,11 @@ class InflationRun {
       return false;
     }
     int resumes_left = MAX_RESUMES;
-    bool from_bent_try = false;  // this attempt continues the early bent try (see try_bending_early)
+    bool from_bent_try = false;  // the next attempt continues the early bent try (see try_bending_early)
     while (std::abs(target_volume - state.volume) > 1e-14 * target_volume) {
       const double next = std::abs(step) >= std::abs(target_volume - state.volume) ? target_volume : state.volume + step;
-      if (volume_step(state, next, report, from_bent_try ? &m_bent_try_unfinished : nullptr)) {
+      const PathPoint* resume = std::exchange(from_bent_try, false) ? &m_bent_try_unfinished : nullptr;
+      if (volume_step(state, next, report, resume)) {
         if (report.iterations <= 6) step *= 2.0;
         resumes_left = MAX_RESUMES;
         continue;
@@ -317,7 +319,6 @@ class InflationRun {
         from_bent_try = m_bent_try_unfinished.x.size() > 0 && m_bent_try_unfinished.volume == next;
         continue;
       }
-      from_bent_try = false;
       step *= 0.5;
       if (std::abs(step) < smallest) {
         message = "no equilibrium found at volume ratio " + format_number(next / m_model.volume(flat_rest())) +
