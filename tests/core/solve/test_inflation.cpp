@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "mesh/icosphere.hpp"
 #include "mesh/mesh_checks.hpp"
@@ -31,6 +33,20 @@ double sphere_pressure_kpa(const Material& material, double h, double R, double 
 
 double mesh_volume(const TriMesh& m) { return enclosed_volume(m.vertices, m.faces); }
 double mesh_area(const TriMesh& m) { return surface_area(m.vertices, m.faces); }
+
+/// Inflates `file` of tests/data/meshes, scaled to a `diagonal_mm` bounding-box diagonal, 0.5 mm thick,
+/// with the material `spec`, to `volume_ratio`.
+InflationResult inflate_corpus_mesh(const std::string& file, double diagonal_mm, const std::string& spec,
+                                    double volume_ratio) {
+  auto mesh = read_mesh(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/" + file);
+  if (!mesh.ok()) throw std::runtime_error(mesh.error());
+  mesh->vertices *= diagonal_mm / bounding_box_diagonal(mesh->vertices);
+  InflationOptions options;
+  options.material = *parse_material_spec(spec);
+  options.thickness_mm = 0.5;
+  options.volume_ratio = volume_ratio;
+  return inflate(*mesh, options);
+}
 
 struct SphereCase {
   const char* label;
@@ -220,14 +236,7 @@ class CorpusInflationTest : public ::testing::TestWithParam<CorpusCase> {};
 
 TEST_P(CorpusInflationTest, ConvergesToTheVolumeRatio) {
   const CorpusCase& c = GetParam();
-  auto mesh = read_mesh(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/" + c.file);
-  ASSERT_TRUE(mesh.ok()) << mesh.error();
-  mesh->vertices *= 200.0 / bounding_box_diagonal(mesh->vertices);
-  InflationOptions options;
-  options.material = *parse_material_spec(c.material);
-  options.thickness_mm = 0.5;
-  options.volume_ratio = c.volume_ratio;
-  const InflationResult result = inflate(*mesh, options);
+  const InflationResult result = inflate_corpus_mesh(c.file, 200.0, c.material, c.volume_ratio);
   ASSERT_EQ(inflation_stop_word(result.stop), std::string(inflation_stop_word(c.expected))) << c.label << ": " << result.message;
   EXPECT_EQ(result.converged, c.expected == InflationStop::Converged);
   EXPECT_NEAR(result.volume_ratio, c.volume_ratio, 1e-6 * c.volume_ratio);
@@ -357,14 +366,7 @@ TEST(Inflation, AStepThatCreepsThroughWrinklesTriesTheSheetsBendingAtOnce) {
   // The femur (200 mm, silicone) to ratio 2: as a membrane its first volume step creeps through wrinkles
   // (its stiffness indefinite at most factorizations); four resumes took 240 Newton steps before bending
   // went on, 386 in all. Tried with bending after the first failed attempt: 81.
-  auto femur = read_mesh(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/femur.off");
-  ASSERT_TRUE(femur.ok()) << femur.error();
-  femur->vertices *= 200.0 / bounding_box_diagonal(femur->vertices);
-  InflationOptions options;
-  options.material = *parse_material_spec("silicone");
-  options.thickness_mm = 0.5;
-  options.volume_ratio = 2.0;
-  const InflationResult result = inflate(*femur, options);
+  const InflationResult result = inflate_corpus_mesh("femur.off", 200.0, "silicone", 2.0);
   ASSERT_TRUE(result.converged) << result.message;
   EXPECT_TRUE(result.bending);
   EXPECT_NEAR(result.volume_ratio, 2.0, 2e-6);
@@ -376,14 +378,7 @@ TEST(Inflation, ShiftedStepsPastAPressureMaximumHandOverToTheExactStep) {
   // Its shifted SQP steps crept at |r| ~ 3e-3 N where the exact step converged in 3 once tried, and its
   // bent path was tried early, dropped, and later run again from the start. With the exact step tried
   // again after each tenfold fall of the residual, and the early bent try's end kept: 112.
-  auto femur = read_mesh(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/femur.off");
-  ASSERT_TRUE(femur.ok()) << femur.error();
-  femur->vertices *= 20.0 / bounding_box_diagonal(femur->vertices);
-  InflationOptions options;
-  options.material = *parse_material_spec("latex");
-  options.thickness_mm = 0.5;
-  options.volume_ratio = 27.0;
-  const InflationResult result = inflate(*femur, options);
+  const InflationResult result = inflate_corpus_mesh("femur.off", 20.0, "latex", 27.0);
   ASSERT_TRUE(result.converged) << result.message;
   EXPECT_NEAR(result.volume_ratio, 27.0, 27.0 * 1e-6);
   EXPECT_LT(result.newton_iterations, 200);
@@ -394,14 +389,7 @@ TEST(Inflation, PastAPressureMaximumTheExactStepDescendsOnTheAugmentedLagrangian
   // negative pivot that the volume constraint removes. Line-searched on the residual norm there, the exact
   // steps led to a membrane equilibrium that passes through itself; on the augmented Lagrangian, as for a
   // positive definite stiffness, the path reaches one (with the sheet's bending) that does not.
-  auto dino = read_mesh(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/dino.off");
-  ASSERT_TRUE(dino.ok()) << dino.error();
-  dino->vertices *= 200.0 / bounding_box_diagonal(dino->vertices);
-  InflationOptions options;
-  options.material = *parse_material_spec("neo-hookean:mu=0.3");
-  options.thickness_mm = 0.5;
-  options.volume_ratio = 8.0;
-  const InflationResult result = inflate(*dino, options);
+  const InflationResult result = inflate_corpus_mesh("dino.off", 200.0, "neo-hookean:mu=0.3", 8.0);
   ASSERT_TRUE(result.converged) << result.message;
   EXPECT_EQ(result.stop, InflationStop::Converged);
   EXPECT_NEAR(result.volume_ratio, 8.0, 8.0 * 1e-6);
