@@ -336,18 +336,14 @@ NewtonReport EquilibriumSolver::newton_volume(Eigen::VectorXd& x, double& pressu
         // steps instead of 84.
         const Eigen::VectorXd step = m_assembly.extend(a + dp * b);
         const double merit0 = std::pow(report.residual_norm / force_tolerance, 2) + std::pow(c / volume_tolerance, 2);
-        double t = 1.0;
-        // Towards a saddle (a symmetric state past a bifurcation, as a sphere past its pressure
-        // maximum) only a full step is taken: Newton's own convergence shows the saddle is near;
-        // otherwise the SQP step below leaves it for a stable state.
-        const int halvings = m_last_unstable_modes == 0 ? 8 : 1;
-        for (int k = 0; k < halvings && !exact; ++k, t *= 0.5) {
-          const Eigen::VectorXd trial = x + t * step;
-          if (merit(trial, pressure_mpa + t * dp, force_tolerance) <= (1.0 - 1e-4 * t) * merit0) {
-            x = trial;
-            pressure_mpa += t * dp;
-            exact = true;
-          }
+        // Here K has unstable modes: the step heads for a saddle (a symmetric state past a bifurcation,
+        // as a sphere past its pressure maximum). Only a full step is taken: Newton's own convergence
+        // shows the saddle is near; otherwise the SQP step below leaves it for a stable state.
+        const Eigen::VectorXd trial = x + step;
+        if (merit(trial, pressure_mpa + dp, force_tolerance) <= (1.0 - 1e-4) * merit0) {
+          x = trial;
+          pressure_mpa += dp;
+          exact = true;
         }
       }
       if (!exact) m_exact_fails_left = 2;

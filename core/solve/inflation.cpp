@@ -350,9 +350,10 @@ class InflationRun {
   /// the sheet is a membrane again, with its unfinished attempt as before. `report` becomes the bent
   /// attempt's when that converged or was stopped (time limit, cancel), and stays the membrane's otherwise.
   /// A failed try that was still converging leaves its end in m_bent_try_unfinished, which the attempt
-  /// right after bending goes on for good at this same step resumes instead of starting over. Without it the femur at ratio 2 crept through 4 membrane resumes (240 Newton steps) before bending
-  /// went on; a bent attempt that fails costs the anchor and knot, whose membrane paths do reach an
-  /// answer, one attempt.
+  /// right after bending goes on for good at this same step resumes instead of starting over. Without
+  /// it the femur at ratio 2 crept through 4 membrane resumes (240 Newton steps) before bending went on;
+  /// a bent attempt that fails costs the anchor and knot, whose membrane paths do reach an answer, one
+  /// attempt.
   bool try_bending_early(PathPoint& state, double next_volume, NewtonReport& report) {
     if (m_tried_bending_early || !switch_bending_on()) return false;
     m_tried_bending_early = true;
