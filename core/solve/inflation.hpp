@@ -35,7 +35,8 @@ struct InflationOptions {
   bool tension_field = false;
   /// The sheet's bending stiffness D = G h^3 / 3 as discrete-shell hinges (fem/hinge_bending.hpp): gives
   /// compressed regions a stable folded state instead of ever finer wrinkles. `Auto` (the default)
-  /// inflates as a pure membrane and switches bending on only when a volume step fails to converge
+  /// inflates as a pure membrane and switches bending on only when a volume step fails to converge, or
+  /// (inflate() only) tries again with it once when the membrane's equilibrium passes through itself
   /// (InflationResult::bending says whether it was on at the end).
   BendingUse bending = BendingUse::Auto;
   /// A converged shape whose surface passes through itself (while the rest surface does not) is no
