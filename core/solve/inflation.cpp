@@ -518,6 +518,32 @@ bool passes_through_itself(const TriMesh& rest, const Positions& deformed) {
   }
 }
 
+/// A membrane's equilibrium can pass through itself by a fold of its wrinkles (the dinosaur with latex at
+/// x27: its limbs), which the sheet's bending smooths out: tried once more, from the start, with bending
+/// on and the budget left. A converged bent result replaces `result` (the counters add up either way);
+/// otherwise returns why it did not.
+std::string retry_with_bending(const TriMesh& rest, const InflationOptions& options, const Positions* initial_guess,
+                               InflationResult& result) {
+  if (options.max_time_s > 0.0 && result.time_s >= options.max_time_s) return "no time left";
+  InflationOptions bent = options;
+  bent.bending = BendingUse::On;
+  if (options.max_time_s > 0.0) bent.max_time_s = options.max_time_s - result.time_s;
+  InflationResult second = InflationRun(rest, bent).run(initial_guess);
+  second.newton_iterations += result.newton_iterations;
+  second.factorizations += result.factorizations;
+  second.load_steps += result.load_steps;
+  second.time_s += result.time_s;
+  if (second.converged) {
+    result = std::move(second);
+    return "";
+  }
+  result.newton_iterations = second.newton_iterations;
+  result.factorizations = second.factorizations;
+  result.load_steps = second.load_steps;
+  result.time_s = second.time_s;
+  return second.message;
+}
+
 }  // namespace
 
 const char* inflation_stop_word(InflationStop stop) {
@@ -584,43 +610,20 @@ InflationResult inflate(const TriMesh& rest, const InflationOptions& options, co
     return result;
   }
   InflationResult result = InflationRun(rest, options).run(initial_guess);
-  auto passes = [&](const InflationResult& r) {
-    return r.converged && options.reject_self_intersection && passes_through_itself(rest, r.deformed);
-  };
-  bool passing = passes(result);
-  if (passing && options.bending == BendingUse::Auto && !result.bending) {
-    // A membrane's equilibrium can pass through itself by a fold of its wrinkles (the dinosaur with latex
-    // at x27: its limbs), which the sheet's bending smooths out: tried once more, from the start, with
-    // bending on and the budget left.
-    InflationOptions bent = options;
-    bent.bending = BendingUse::On;
-    const bool time_left = options.max_time_s <= 0.0 || result.time_s < options.max_time_s;  // 0: no budget
-    if (options.max_time_s > 0.0) bent.max_time_s = options.max_time_s - result.time_s;
-    if (time_left) {
-      InflationResult second = InflationRun(rest, bent).run(initial_guess);
-      second.newton_iterations += result.newton_iterations;
-      second.factorizations += result.factorizations;
-      second.load_steps += result.load_steps;
-      second.time_s += result.time_s;
-      if (second.converged) {
-        result = std::move(second);
-        passing = passes(result);
-      } else {
-        result.newton_iterations = second.newton_iterations;
-        result.factorizations = second.factorizations;
-        result.load_steps = second.load_steps;
-        result.time_s = second.time_s;
-      }
-    }
+  if (!result.converged || !options.reject_self_intersection || !passes_through_itself(rest, result.deformed))
+    return result;
+  std::string bent_try;
+  if (options.bending == BendingUse::Auto && !result.bending) {
+    bent_try = retry_with_bending(rest, options, initial_guess, result);
+    if (bent_try.empty() && !passes_through_itself(rest, result.deformed)) return result;
   }
-  if (passing) {
-    result.converged = false;
-    result.stop = InflationStop::PassesThroughItself;
-    result.message = std::string("no equilibrium: the ") + (result.bending ? "bent sheet's" : "membrane's") +
-                     " equilibrium at volume ratio " + format_number(result.volume_ratio) + " (" +
-                     format_kpa(result.pressure_kpa * MPA_PER_KPA) +
-                     ") passes through itself; its walls touch on the way there, and this model has no contact";
-  }
+  result.converged = false;
+  result.stop = InflationStop::PassesThroughItself;
+  result.message = std::string("no equilibrium: the ") + (result.bending ? "bent sheet's" : "membrane's") +
+                   " equilibrium at volume ratio " + format_number(result.volume_ratio) + " (" +
+                   format_kpa(result.pressure_kpa * MPA_PER_KPA) +
+                   ") passes through itself; its walls touch on the way there, and this model has no contact" +
+                   (bent_try.empty() ? "" : "; tried again with the sheet's bending: " + bent_try);
   return result;
 }
 
