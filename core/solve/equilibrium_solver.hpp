@@ -175,6 +175,7 @@ class EquilibriumSolver {
   int m_exact_fails_left = 0;
   int m_last_unstable_modes = 0;
   double m_sqp_shift = 0.0;        ///< Levenberg shift of the last SQP step (N/mm)
+  bool m_sqp_cut_short = false;    ///< the last SQP step was cut short (or failed): the next starts shifted
   int m_sqp_unshifted_steps = 0;        ///< consecutive unshifted SQP steps: close enough for the exact step
   bool m_last_step_exact = false;  ///< the last volume step was the exact one
   bool m_exact_indefinite = false;  ///< the last exact stiffness had negative pivots: skip the LL^T attempt
