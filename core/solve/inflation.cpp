@@ -529,19 +529,14 @@ std::string retry_with_bending(const TriMesh& rest, const InflationOptions& opti
   bent.bending = BendingUse::On;
   if (options.max_time_s > 0.0) bent.max_time_s = options.max_time_s - result.time_s;
   InflationResult second = InflationRun(rest, bent).run(initial_guess);
-  second.newton_iterations += result.newton_iterations;
-  second.factorizations += result.factorizations;
-  second.load_steps += result.load_steps;
-  second.time_s += result.time_s;
-  if (second.converged) {
-    result = std::move(second);
-    return "";
-  }
-  result.newton_iterations = second.newton_iterations;
-  result.factorizations = second.factorizations;
-  result.load_steps = second.load_steps;
-  result.time_s = second.time_s;
-  return second.message;
+  InflationResult& kept = second.converged ? second : result;
+  kept.newton_iterations = result.newton_iterations + second.newton_iterations;
+  kept.factorizations = result.factorizations + second.factorizations;
+  kept.load_steps = result.load_steps + second.load_steps;
+  kept.time_s = result.time_s + second.time_s;
+  if (!second.converged) return second.message;
+  result = std::move(second);
+  return "";
 }
 
 }  // namespace
