@@ -112,6 +112,7 @@ bool DesignDriver::inflate_start_to_target_volume(const Eigen::VectorXd& rest, D
   inflation.volume_ratio = m_target_volume / rest_volume(rest);
   inflation.residual_tolerance = m_settings.relative_tolerance;
   inflation.sqp_shift_restart = m_settings.shift_restart;
+  inflation.sqp_shift_after_cut_short = m_settings.shift_after_cut_short;
   inflation.reject_self_intersection = false;  // the design moves the shape away from itself
   // The augmented Lagrangian assembles membrane-only derivatives: no bending there.
   inflation.bending = m_options.method == DesignMethod::Adjoint ? BendingUse::Auto : BendingUse::Off;

@@ -358,7 +358,7 @@ NewtonReport EquilibriumSolver::newton_volume(Eigen::VectorXd& x, double& pressu
 
     // Robust path (wrinkling, snap-through, past limit points, far from a solution): an SQP step on a
     // positive definite model of the Hessian, which descends towards a constrained minimum of W.
-    if (!sqp_step(x, pressure_mpa, target_volume, v, r, c, settings.shift_restart)) {
+    if (!sqp_step(x, pressure_mpa, target_volume, v, r, c, settings)) {
       report.stop = NewtonStop::LineSearchFailed;
       report.message = "line search failed";
       return report;
@@ -395,7 +395,7 @@ int EquilibriumSolver::kkt_negative_eigenvalues(const Eigen::VectorXd& v) const 
 }
 
 bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
-                                 const Eigen::VectorXd& v, const Eigen::VectorXd& r, double c, double shift_restart) {
+                                 const Eigen::VectorXd& v, const Eigen::VectorXd& r, double c, const NewtonSettings& settings) {
   m_model.assemble_hessian(x, pressure_mpa, m_assembly, true);
   const double base = std::max(1e-30, m_assembly.mean_abs_diagonal());
   // The model H (projected membrane blocks, exact pressure term) is used unshifted when the KKT matrix
@@ -409,12 +409,13 @@ bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, doubl
     return m_solver.factorize_ldlt(m_assembly.values(), trial_shift) == SparseSolver::Status::Ok &&
            kkt_negative_eigenvalues(v) == 1;
   };
-  // After a step cut short the next starts at the raised shift instead of trying the unshifted model
-  // first: on the femur at 20 mm (Neo-Hookean x8) that model, nearly singular along the constraint, gave
-  // steps of 640 mm cut to 1/2048, step after step (436 Newton steps against 108).
-  double shift = m_sqp_cut_short ? m_sqp_shift : 0.0;
+  // With settings.shift_after_cut_short, the step after one cut short starts at the raised shift instead
+  // of trying the unshifted model first: on the femur at 20 mm (Neo-Hookean x8) that model, nearly
+  // singular along the constraint, gave steps of 640 mm cut to 1/2048, step after step.
+  double shift = settings.shift_after_cut_short && m_sqp_cut_short ? m_sqp_shift : 0.0;
   bool factorized = minimum_inertia(shift);
-  if (!factorized) shift = shift > 0.0 ? 10.0 * shift : std::max(shift_restart * m_sqp_shift, 1e-6 * base);
+  if (!factorized)
+    shift = shift > 0.0 ? 10.0 * shift : std::max(settings.shift_restart * m_sqp_shift, 1e-6 * base);
   while (!factorized) {
     if (shift > 1e8 * base) return false;
     factorized = minimum_inertia(shift);

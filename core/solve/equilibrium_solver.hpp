@@ -72,12 +72,18 @@ struct NewtonSettings {
   const CancelToken* cancel = nullptr;
   double deadline_s = 0.0;  ///< absolute time (steady clock seconds) after which to stop; 0 = none
   /// Volume control: a shifted SQP step starts its search for the Levenberg shift from this fraction of
-  /// the last one (then x10 until the model is positive definite). A long path through snap-throughs
+  /// the last one (then x10 until the KKT inertia is a constrained minimum's). A long path through snap-throughs
   /// and wrinkling (inflate()) restarts from 1/2: from 1/4 the shift cycled a decade above what the
   /// model needed and cut every step short (knot, femur). The design keeps 1/4, for its start too: its
   /// result depends on which of two equally converged starts it gets (spot with latex past its pressure
   /// maximum: 8.7x the baseline from the start solved with 1/4, 1.9x from the one solved with 1/2).
   double shift_restart = 0.25;
+  /// Volume control: the SQP step after one cut short (more than two halvings) starts at the raised
+  /// shift instead of trying the unshifted model first. inflate() turns it on (bench_robustness: 13 -> 9
+  /// failures of 432; the femur at 20 mm, Neo-Hookean x8: 436 -> 108 Newton steps); the design keeps it
+  /// off, for its start too: with it its latex corpus fell from 12/18 to 10/18 designs at 2x (teddy
+  /// 4.6x -> 2.5x, stalled), silicone unchanged.
+  bool shift_after_cut_short = false;
   /// Volume control: give up (NewtonStop::Slow) when, after four or more steps, the residual has not
   /// halved over the last two. For a caller that has a cheaper way on than a slow path to the end: the
   /// design's trials start a first-order step from their solution, so a trial that converges this slowly
@@ -146,9 +152,9 @@ class EquilibriumSolver {
   int kkt_negative_eigenvalues(const Eigen::VectorXd& v) const;
   /// One SQP step for volume control with a positive definite model of the Hessian (projected membrane
   /// blocks plus a Levenberg shift), globalised on the augmented Lagrangian at the new multiplier.
-  /// `shift_restart` is NewtonSettings::shift_restart.
+  /// `settings` gives shift_restart and shift_after_cut_short.
   bool sqp_step(Eigen::VectorXd& x, double& pressure_mpa, double target_volume, const Eigen::VectorXd& v,
-                const Eigen::VectorXd& r, double c, double shift_restart);
+                const Eigen::VectorXd& r, double c, const NewtonSettings& settings);
   /// KKT step of the factorized positive definite Hessian (model), line-searched on the augmented
   /// Lagrangian at the new multiplier or on a clear fall of the KKT residual. The number of step
   /// halvings the accepted step needed, or -1 if no step helped. `exact_model`: the factorization is

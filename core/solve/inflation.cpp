@@ -79,6 +79,7 @@ class InflationRun {
     m_settings.relative_tolerance = options.residual_tolerance;
     m_settings.max_iterations = 60;
     m_settings.shift_restart = options.sqp_shift_restart;
+    m_settings.shift_after_cut_short = options.sqp_shift_after_cut_short;
     m_settings.cancel = options.cancel;
     m_settings.deadline_s = options.max_time_s > 0 ? m_start + options.max_time_s : 0.0;
   }

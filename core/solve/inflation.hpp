@@ -46,6 +46,8 @@ struct InflationOptions {
   /// NewtonSettings::shift_restart for this path: 1/2, for long paths through snap-throughs and wrinkles
   /// (bench_robustness: 24 -> 19 failures of 432 against 1/4). The design's start passes its own 1/4.
   double sqp_shift_restart = 0.5;
+  /// NewtonSettings::shift_after_cut_short for this path; the design's start passes its own (off).
+  bool sqp_shift_after_cut_short = true;
   ProgressCallback progress;                 ///< optional
   const CancelToken* cancel = nullptr;       ///< optional
 };
