@@ -90,6 +90,10 @@ std::string summary_from_report(const v1::SimulateReport& report) {
   if (report.bending())
     out << "  bending        on: the membrane alone wrinkled with no stable state, so the sheet's bending\n"
            "                 stiffness (G h^3 / 3) was added\n";
+  if (report.flipped_cap_slivers() > 0)
+    out << "  slivers        " << report.flipped_cap_slivers()
+        << " cap sliver(s) (a vertex almost on its opposite edge) simulated with their pair's other\n"
+           "                 diagonal; no vertex moved\n";
   out << "  material       " << report.material();
   if (!report.material_name().empty()) out << " (" << report.material_name() << ")";
   out << ", thickness " << format("%.6g", report.thickness_mm()) << " mm\n";

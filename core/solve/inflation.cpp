@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "fem/balloon_model.hpp"
+#include "mesh/cap_sliver_flips.hpp"
 #include "mesh/self_intersection.hpp"
 #include "solve/equilibrium_solver.hpp"
 #include "solve/rigid_modes.hpp"
@@ -507,6 +508,26 @@ std::string options_problem(const TriMesh& rest, const InflationOptions& options
   return "";
 }
 
+/// The mesh and options a run simulates: the rest mesh with its cap slivers flipped away (same vertices,
+/// so its deformed positions are the caller's), a flipped pair taking the mean of its two thicknesses.
+struct SimulationMesh {
+  TriMesh rest;
+  InflationOptions options;
+  int flipped_cap_slivers = 0;
+};
+
+SimulationMesh simulation_mesh(const TriMesh& rest, const InflationOptions& options) {
+  CapSliverFlips flips = flip_cap_slivers(rest);
+  SimulationMesh simulated{TriMesh{rest.vertices, std::move(flips.faces)}, options,
+                           static_cast<int>(flips.flipped_pairs.size())};
+  std::vector<double>& thickness = simulated.options.element_thickness_mm;
+  if (!thickness.empty())
+    for (const auto& [f, g] : flips.flipped_pairs)
+      thickness[static_cast<size_t>(f)] = thickness[static_cast<size_t>(g)] =
+          0.5 * (thickness[static_cast<size_t>(f)] + thickness[static_cast<size_t>(g)]);
+  return simulated;
+}
+
 /// The deformed surface intersects itself while the rest surface does not (a rest mesh that already
 /// does says nothing about the inflation). A mesh CGAL cannot take is not judged.
 bool passes_through_itself(const TriMesh& rest, const Positions& deformed) {
@@ -557,14 +578,16 @@ const char* inflation_stop_word(InflationStop stop) {
 
 struct InflationPath::Impl {
   Impl(const TriMesh& rest_mesh, const InflationOptions& path_options)
-      : rest(rest_mesh), options(path_options), problem(options_problem(rest, options)) {
+      : problem(options_problem(rest_mesh, path_options)) {
     if (problem.empty()) {
-      run = std::make_unique<InflationRun>(rest, options);
+      simulated = simulation_mesh(rest_mesh, path_options);
+      run = std::make_unique<InflationRun>(simulated.rest, simulated.options);
       run->use_path_predictor();
+    } else {
+      simulated.rest = rest_mesh;
     }
   }
-  TriMesh rest;  // copies: the run keeps references to both
-  InflationOptions options;
+  SimulationMesh simulated;  // the run keeps references to its mesh and options
   std::string problem;
   std::unique_ptr<InflationRun> run;
 };
@@ -589,10 +612,12 @@ InflationResult InflationPath::advance(InflationControl control, double target) 
     InflationResult result;
     result.stop = InflationStop::InvalidInput;
     result.message = problem;
-    result.deformed = m->rest.vertices;
+    result.deformed = m->simulated.rest.vertices;
     return result;
   }
-  return m->run->advance(control, target);
+  InflationResult result = m->run->advance(control, target);
+  result.flipped_cap_slivers = m->simulated.flipped_cap_slivers;
+  return result;
 }
 
 int InflationPath::pressure_unstable_modes() { return m->run ? m->run->pressure_unstable_modes() : -1; }
@@ -605,13 +630,16 @@ InflationResult inflate(const TriMesh& rest, const InflationOptions& options, co
     result.deformed = rest.vertices;
     return result;
   }
-  InflationResult result = InflationRun(rest, options).run(initial_guess);
-  if (!result.converged || !options.reject_self_intersection || !passes_through_itself(rest, result.deformed))
+  const SimulationMesh simulated = simulation_mesh(rest, options);
+  InflationResult result = InflationRun(simulated.rest, simulated.options).run(initial_guess);
+  result.flipped_cap_slivers = simulated.flipped_cap_slivers;
+  if (!result.converged || !options.reject_self_intersection || !passes_through_itself(simulated.rest, result.deformed))
     return result;
   std::string bent_try;
   if (options.bending == BendingUse::Auto && !result.bending) {
-    bent_try = retry_with_bending(rest, options, initial_guess, result);
-    if (bent_try.empty() && !passes_through_itself(rest, result.deformed)) return result;
+    bent_try = retry_with_bending(simulated.rest, simulated.options, initial_guess, result);
+    result.flipped_cap_slivers = simulated.flipped_cap_slivers;
+    if (bent_try.empty() && !passes_through_itself(simulated.rest, result.deformed)) return result;
   }
   result.converged = false;
   result.stop = InflationStop::PassesThroughItself;

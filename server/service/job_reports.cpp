@@ -30,6 +30,7 @@ v1::SimulateReport simulate_report(const jobs::SimulateInput& input, const Infla
   report.set_residual_norm(result.residual_norm);
   report.set_unstable_modes(result.unstable_modes);
   report.set_bending(result.bending);
+  report.set_flipped_cap_slivers(result.flipped_cap_slivers);
   report.set_time_s(result.time_s);
   report.set_vertices(input.rest.vertex_count());
   report.set_faces(input.rest.face_count());
