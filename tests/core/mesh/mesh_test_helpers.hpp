@@ -75,6 +75,49 @@ inline TriMesh unit_cube() {
   return cube;
 }
 
+/// An icosphere (radius mm) with one cap sliver of smallest angle `angle_deg`: its face (a, b, c) is split
+/// at m, inside the face at tan(angle) |ab| / 2 from the midpoint of ab, into (a, m, c), (m, b, c) and
+/// the cap (a, b, m), which is the last face.
+inline TriMesh sphere_with_cap_sliver(double radius, int subdivisions, double angle_deg) {
+  TriMesh mesh = make_icosphere(radius, subdivisions);
+  const int a = mesh.faces(0, 0), b = mesh.faces(0, 1), c = mesh.faces(0, 2);
+  const Eigen::RowVector3d pa = mesh.vertices.row(a), pb = mesh.vertices.row(b), pc = mesh.vertices.row(c);
+  const Eigen::RowVector3d mid = 0.5 * (pa + pb);
+  const double offset = std::tan(angle_deg * M_PI / 180.0) * 0.5 * (pb - pa).norm();
+  const int m = mesh.vertex_count();
+  mesh.vertices.conservativeResize(m + 1, 3);
+  mesh.vertices.row(m) = mid + offset * (pc - mid).normalized();
+  const int f = mesh.face_count();
+  mesh.faces.conservativeResize(f + 2, 3);
+  mesh.faces.row(0) << a, m, c;
+  mesh.faces.row(f) << m, b, c;
+  mesh.faces.row(f + 1) << a, b, m;
+  return mesh;
+}
+
+/// An icosphere (radius mm) with two needle slivers of smallest angle about `angle_deg`: a vertex m on the
+/// edge ab of its first face, at tan(angle) |ac| from a, splits both faces of that edge; (a, m, c) and
+/// its neighbour across am are the needles (a short edge, two long ones).
+inline TriMesh sphere_with_needle_slivers(double radius, int subdivisions, double angle_deg) {
+  TriMesh mesh = make_icosphere(radius, subdivisions);
+  const int a = mesh.faces(0, 0), b = mesh.faces(0, 1), c = mesh.faces(0, 2);
+  int across = -1, o = -1;
+  for (int f = 1; f < mesh.face_count() && across < 0; ++f)
+    for (int k = 0; k < 3; ++k)
+      if (mesh.faces(f, k) == b && mesh.faces(f, (k + 1) % 3) == a) across = f, o = mesh.faces(f, (k + 2) % 3);
+  const Eigen::RowVector3d pa = mesh.vertices.row(a), pb = mesh.vertices.row(b), pc = mesh.vertices.row(c);
+  const int m = mesh.vertex_count();
+  mesh.vertices.conservativeResize(m + 1, 3);
+  mesh.vertices.row(m) = pa + std::tan(angle_deg * M_PI / 180.0) * (pc - pa).norm() * (pb - pa).normalized();
+  const int f = mesh.face_count();
+  mesh.faces.conservativeResize(f + 2, 3);
+  mesh.faces.row(0) << a, m, c;
+  mesh.faces.row(f) << m, b, c;
+  mesh.faces.row(across) << b, m, o;
+  mesh.faces.row(f + 1) << m, a, o;
+  return mesh;
+}
+
 /// True if `actual` is `expected` up to vertex renumbering: every vertex has a partner within
 /// relative_tolerance * bounding-box diagonal and the faces map onto the same oriented triangles.
 /// Brute force: for small meshes only.

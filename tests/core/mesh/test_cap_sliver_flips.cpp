@@ -13,26 +13,8 @@
 namespace balloon {
 namespace {
 
-/// An icosphere whose face (a, b, c) is split at m, a point `height_fraction` |ab| from the midpoint of
-/// ab towards c: (a, m, c), (m, b, c) and the cap (a, b, m).
-TriMesh sphere_with_cap(double height_fraction) {
-  TriMesh mesh = make_icosphere(50.0, 2);
-  const int a = mesh.faces(0, 0), b = mesh.faces(0, 1), c = mesh.faces(0, 2);
-  const Eigen::RowVector3d pa = mesh.vertices.row(a), pb = mesh.vertices.row(b), pc = mesh.vertices.row(c);
-  const Eigen::RowVector3d mid = 0.5 * (pa + pb);
-  const int m = mesh.vertex_count();
-  mesh.vertices.conservativeResize(m + 1, 3);
-  mesh.vertices.row(m) = mid + height_fraction * (pb - pa).norm() * (pc - mid).normalized();
-  const int f = mesh.face_count();
-  mesh.faces.conservativeResize(f + 2, 3);
-  mesh.faces.row(0) << a, m, c;
-  mesh.faces.row(f) << m, b, c;
-  mesh.faces.row(f + 1) << a, b, m;
-  return mesh;
-}
-
 TEST(CapSliverFlips, AThousandthOfADegreeCapIsFlippedWithoutMovingAVertex) {
-  const TriMesh mesh = sphere_with_cap(0.5 * std::tan(0.001 * M_PI / 180.0));
+  const TriMesh mesh = test::sphere_with_cap_sliver(50.0, 2, 0.001);
   ASSERT_LT(min_angle_deg(mesh.vertices, mesh.faces), 0.0011);
   const CapSliverFlips flips = flip_cap_slivers(mesh);
   ASSERT_EQ(flips.flipped_pairs.size(), 1u);
@@ -64,7 +46,7 @@ TEST(CapSliverFlips, WellShapedTrianglesAndMildCapsAreLeftAlone) {
   const CapSliverFlips none = flip_cap_slivers(sphere);
   EXPECT_TRUE(none.flipped_pairs.empty());
   EXPECT_EQ(none.faces, sphere.faces);
-  const TriMesh mild = sphere_with_cap(0.5 * std::tan(0.5 * M_PI / 180.0));  // a half-degree cap
+  const TriMesh mild = test::sphere_with_cap_sliver(50.0, 2, 0.5);
   EXPECT_TRUE(flip_cap_slivers(mild).flipped_pairs.empty());
 }
 
