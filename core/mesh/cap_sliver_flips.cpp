@@ -42,6 +42,12 @@ CapSliverFlips flip_cap_slivers(const TriMesh& mesh, double sliver_angle_deg) {
   CapSliverFlips out;
   out.faces = mesh.faces;
   const Positions& vertices = mesh.vertices;
+  // Almost every mesh has no sliver at all: one pass of angles, and no edge map, for those.
+  bool any_sliver = false;
+  for (int f = 0; f < out.faces.rows() && !any_sliver; ++f)
+    any_sliver = smallest_angle(vertices, out.faces.row(f).transpose()) < sliver_angle_deg;
+  if (!any_sliver) return out;
+
   std::unordered_map<long long, int> face_of_edge;  // directed edge -> the face that traverses it
   auto index_face = [&](int f, bool add) {
     for (int k = 0; k < 3; ++k) {
