@@ -4,27 +4,15 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "mesh/mesh_geometry.hpp"
+
 namespace balloon {
 namespace {
 
 using Corner = Eigen::Vector3d;
 
-/// Interior angle (degrees) at p between the directions to q and r.
-double angle_deg(const Corner& p, const Corner& q, const Corner& r) {
-  const Corner u = q - p, v = r - p;
-  return std::atan2(u.cross(v).norm(), u.dot(v)) * 180.0 / M_PI;
-}
-
-std::array<double, 3> corner_angles(const Positions& vertices, const Eigen::Vector3i& face) {
-  std::array<double, 3> angles{};
-  for (int k = 0; k < 3; ++k)
-    angles[static_cast<size_t>(k)] = angle_deg(vertices.row(face[k]).transpose(), vertices.row(face[(k + 1) % 3]).transpose(),
-                                                vertices.row(face[(k + 2) % 3]).transpose());
-  return angles;
-}
-
 double smallest_angle(const Positions& vertices, const Eigen::Vector3i& face) {
-  const auto angles = corner_angles(vertices, face);
+  const std::array<double, 3> angles = corner_angles_deg(vertices, face);
   return *std::min_element(angles.begin(), angles.end());
 }
 
@@ -43,10 +31,7 @@ CapSliverFlips flip_cap_slivers(const TriMesh& mesh, double sliver_angle_deg) {
   out.faces = mesh.faces;
   const Positions& vertices = mesh.vertices;
   // Almost every mesh has no sliver at all: one pass of angles, and no edge map, for those.
-  bool any_sliver = false;
-  for (int f = 0; f < out.faces.rows() && !any_sliver; ++f)
-    any_sliver = smallest_angle(vertices, out.faces.row(f).transpose()) < sliver_angle_deg;
-  if (!any_sliver) return out;
+  if (min_angle_deg(vertices, out.faces) >= sliver_angle_deg) return out;
 
   std::unordered_map<long long, int> face_of_edge;  // directed edge -> the face that traverses it
   auto index_face = [&](int f, bool add) {
@@ -64,7 +49,7 @@ CapSliverFlips flip_cap_slivers(const TriMesh& mesh, double sliver_angle_deg) {
     bool flipped = false;
     for (int f = 0; f < out.faces.rows(); ++f) {
       const Eigen::Vector3i cap = out.faces.row(f).transpose();
-      const auto angles = corner_angles(vertices, cap);
+      const std::array<double, 3> angles = corner_angles_deg(vertices, cap);
       const double cap_smallest = *std::min_element(angles.begin(), angles.end());
       if (cap_smallest >= sliver_angle_deg) continue;
       const int obtuse = static_cast<int>(std::max_element(angles.begin(), angles.end()) - angles.begin());

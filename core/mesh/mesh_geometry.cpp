@@ -44,18 +44,25 @@ Eigen::RowVector3d centroid(const Positions& vertices) {
   return vertices.colwise().mean();
 }
 
-double min_angle_deg(const Positions& vertices, const Faces& faces) {
-  double min_angle = std::numbers::pi;
-  for (Eigen::Index f = 0; f < faces.rows(); ++f) {
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::RowVector3d corner = vertices.row(faces(f, k));
-      const Eigen::RowVector3d u = vertices.row(faces(f, (k + 1) % 3)) - corner;
-      const Eigen::RowVector3d w = vertices.row(faces(f, (k + 2) % 3)) - corner;
-      // atan2 of |u x w| and u . w stays accurate for the tiny angles of slivers, where acos does not.
-      min_angle = std::min(min_angle, std::atan2(u.cross(w).norm(), u.dot(w)));
-    }
+std::array<double, 3> corner_angles_deg(const Positions& vertices, const Eigen::Vector3i& face) {
+  std::array<double, 3> angles{};
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::RowVector3d corner = vertices.row(face[k]);
+    const Eigen::RowVector3d u = vertices.row(face[(k + 1) % 3]) - corner;
+    const Eigen::RowVector3d w = vertices.row(face[(k + 2) % 3]) - corner;
+    // atan2 of |u x w| and u . w stays accurate for the tiny angles of slivers, where acos does not.
+    angles[static_cast<size_t>(k)] = std::atan2(u.cross(w).norm(), u.dot(w)) * 180.0 / std::numbers::pi;
   }
-  return min_angle * 180.0 / std::numbers::pi;
+  return angles;
+}
+
+double min_angle_deg(const Positions& vertices, const Faces& faces) {
+  double min_angle = 180.0;
+  for (Eigen::Index f = 0; f < faces.rows(); ++f) {
+    const std::array<double, 3> angles = corner_angles_deg(vertices, faces.row(f).transpose());
+    min_angle = std::min(min_angle, *std::min_element(angles.begin(), angles.end()));
+  }
+  return min_angle;
 }
 
 EdgeTopology build_edge_topology(const Faces& faces, int vertex_count) {

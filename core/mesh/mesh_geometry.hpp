@@ -2,6 +2,8 @@
 /// Mesh-wide measures (volume, area, size, quality) and the edge list with its adjacent faces.
 #include <Eigen/Core>
 
+#include <array>
+
 #include "mesh/tri_mesh.hpp"
 
 namespace balloon {
@@ -19,6 +21,10 @@ double bounding_box_diagonal(const Positions& vertices);
 
 /// Mean of the rows of V (#V x 3, mm); a cheap centre for meshes with roughly uniform sampling.
 Eigen::RowVector3d centroid(const Positions& vertices);
+
+/// Interior angles (degrees) at the corners face[0], face[1], face[2] of one triangle over positions V
+/// (#V x 3, mm); accurate down to the tiny angles of slivers.
+std::array<double, 3> corner_angles_deg(const Positions& vertices, const Eigen::Vector3i& face);
 
 /// Smallest interior angle (degrees) over all triangles F (#F x 3); 180 if F is empty.
 double min_angle_deg(const Positions& vertices, const Faces& faces);
