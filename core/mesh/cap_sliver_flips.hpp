@@ -26,7 +26,8 @@ struct CapSliverFlips {
 /// Flips the edge opposite the obtuse corner of every triangle of `mesh` (closed, manifold, oriented)
 /// whose smallest angle is below `sliver_angle_deg`, when the pair's other diagonal is not an edge
 /// already, both new triangles face the way the neighbour did, and the worse of their smallest angles
-/// beats the pair's. The enclosed volume changes by at most the cap's area times its height / 3.
+/// beats the pair's. The enclosed volume changes by at most the cap's height (over its long edge) times
+/// the neighbour's area / 3.
 /// Repeats until no such flip is left. Vertices are untouched, so a field per vertex computed on the
 /// flipped faces belongs to the input mesh too.
 CapSliverFlips flip_cap_slivers(const TriMesh& mesh, double sliver_angle_deg = CAP_SLIVER_ANGLE_DEG);

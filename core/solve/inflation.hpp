@@ -82,8 +82,8 @@ struct InflationResult {
   int wrinkled_elements = 0;      ///< triangles the tension field relaxed at the end (wrinkled or slack); 0 when it is off
   bool bending = false;           ///< the sheet's bending stiffness was on at the end (see InflationOptions::bending)
   /// Cap slivers (smallest angle below CAP_SLIVER_ANGLE_DEG = 0.1 degree, mesh/cap_sliver_flips.hpp)
-  /// whose edge the simulation flipped: the vertices and the surface are the caller's, only those pairs'
-  /// diagonals differ.
+  /// whose edge the simulation flipped: the vertices are the caller's, only those pairs' diagonals differ
+  /// (the surface moves by at most a cap's height).
   int flipped_cap_slivers = 0;
   int newton_iterations = 0;
   int factorizations = 0;
