@@ -622,23 +622,17 @@ InflationResult InflationPath::advance(InflationControl control, double target) 
 
 int InflationPath::pressure_unstable_modes() { return m->run ? m->run->pressure_unstable_modes() : -1; }
 
-InflationResult inflate(const TriMesh& rest, const InflationOptions& options, const Positions* initial_guess) {
-  if (auto problem = options_problem(rest, options); !problem.empty()) {
-    InflationResult result;
-    result.stop = InflationStop::InvalidInput;
-    result.message = problem;
-    result.deformed = rest.vertices;
-    return result;
-  }
-  const SimulationMesh simulated = simulation_mesh(rest, options);
-  InflationResult result = InflationRun(simulated.rest, simulated.options).run(initial_guess);
-  result.flipped_cap_slivers = simulated.flipped_cap_slivers;
+namespace {
+
+/// inflate() on the simulated mesh: the run, then the answer's check against passing through itself.
+InflationResult inflate_simulated(const SimulationMesh& simulated, const Positions* initial_guess) {
+  const InflationOptions& options = simulated.options;
+  InflationResult result = InflationRun(simulated.rest, options).run(initial_guess);
   if (!result.converged || !options.reject_self_intersection || !passes_through_itself(simulated.rest, result.deformed))
     return result;
   std::string bent_try;
   if (options.bending == BendingUse::Auto && !result.bending) {
-    bent_try = retry_with_bending(simulated.rest, simulated.options, initial_guess, result);
-    result.flipped_cap_slivers = simulated.flipped_cap_slivers;
+    bent_try = retry_with_bending(simulated.rest, options, initial_guess, result);
     if (bent_try.empty() && !passes_through_itself(simulated.rest, result.deformed)) return result;
   }
   result.converged = false;
@@ -648,6 +642,22 @@ InflationResult inflate(const TriMesh& rest, const InflationOptions& options, co
                    format_kpa(result.pressure_kpa * MPA_PER_KPA) +
                    ") passes through itself; its walls touch on the way there, and this model has no contact" +
                    (bent_try.empty() ? "" : "; tried again with the sheet's bending: " + bent_try);
+  return result;
+}
+
+}  // namespace
+
+InflationResult inflate(const TriMesh& rest, const InflationOptions& options, const Positions* initial_guess) {
+  if (auto problem = options_problem(rest, options); !problem.empty()) {
+    InflationResult result;
+    result.stop = InflationStop::InvalidInput;
+    result.message = problem;
+    result.deformed = rest.vertices;
+    return result;
+  }
+  const SimulationMesh simulated = simulation_mesh(rest, options);
+  InflationResult result = inflate_simulated(simulated, initial_guess);
+  result.flipped_cap_slivers = simulated.flipped_cap_slivers;
   return result;
 }
 
