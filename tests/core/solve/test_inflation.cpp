@@ -381,12 +381,13 @@ TEST(Inflation, BendingKeepsTheSphereLawAndAutoLeavesItOffWhereTheMembraneConver
 TEST(Inflation, AStepThatCreepsThroughWrinklesTriesTheSheetsBendingAtOnce) {
   // The femur (200 mm, silicone) to ratio 2: as a membrane its first volume step creeps through wrinkles
   // (its stiffness indefinite at most factorizations); four resumes took 240 Newton steps before bending
-  // went on, 386 in all. Tried with bending after the first failed attempt: 81.
+  // went on, 386 in all. Tried with bending after the first failed attempt (60 membrane steps): 81; after
+  // its first 20 membrane steps, once they show the creep: 41.
   const InflationResult result = inflate_corpus_mesh("femur.off", 200.0, "silicone", 2.0);
   ASSERT_TRUE(result.converged) << result.message;
   EXPECT_TRUE(result.bending);
   EXPECT_NEAR(result.volume_ratio, 2.0, 2e-6);
-  EXPECT_LT(result.newton_iterations, 150);
+  EXPECT_LT(result.newton_iterations, 60);
 }
 
 TEST(Inflation, ShiftedStepsPastAPressureMaximumHandOverToTheExactStep) {
