@@ -334,9 +334,7 @@ class InflationRun {
   /// the membrane attempt goes on from where it stood to its full step budget, as the one attempt it
   /// would have been.
   bool attempt_volume_step(PathPoint& state, double target_volume, NewtonReport& report, const PathPoint* resume) {
-    const bool look_for_creep =
-        !m_tried_bending_early && m_options.bending == BendingUse::Auto && !m_model.bending();
-    if (!look_for_creep) {
+    if (!early_bent_try_available()) {
       if (volume_step(state, target_volume, report, resume)) return true;
     } else if (volume_step(state, target_volume, report, resume, CREEP_CHECK_STEPS)) {
       return true;
@@ -369,6 +367,11 @@ class InflationRun {
     m_inertia.reset();
   }
 
+  /// A membrane under BendingUse::Auto that has not had its early bent try yet.
+  bool early_bent_try_available() const {
+    return !m_tried_bending_early && m_options.bending == BendingUse::Auto && !m_model.bending();
+  }
+
   /// Once per path, the first volume step that creeps through wrinkles as a membrane is tried again with
   /// the sheet's bending on, from where it started. True if that converged (bending then stays on); else
   /// the sheet is a membrane again, with its unfinished attempt as before. `report` becomes the bent
@@ -379,8 +382,9 @@ class InflationRun {
   /// a bent attempt that fails costs the anchor and knot, whose membrane paths do reach an answer, one
   /// attempt.
   bool try_bending_early(PathPoint& state, double next_volume, NewtonReport& report) {
-    if (m_tried_bending_early || !switch_bending_on()) return false;
+    if (!early_bent_try_available()) return false;
     m_tried_bending_early = true;
+    set_bending(true);
     const PathPoint membrane_unfinished = m_unfinished;
     const double membrane_start_residual = m_unfinished_start_residual;
     NewtonReport bent;
