@@ -21,8 +21,10 @@ namespace {
 constexpr double MPA_PER_KPA = 1e-3;
 /// Continuations of one volume step that is still converging slowly (see worth_resuming()).
 constexpr int MAX_RESUMES = 4;
+/// Newton steps of one attempt at a volume step.
+constexpr int ATTEMPT_NEWTON_STEPS = 60;
 /// Newton steps of an attempt after which, while the early bent try is still unused, a membrane that
-/// creeps through wrinkles tries bending (see attempt_volume_step()); an attempt has 60 in all.
+/// creeps through wrinkles tries bending (see attempt_volume_step()).
 constexpr int CREEP_CHECK_STEPS = 20;
 
 double now_s() {
@@ -81,7 +83,7 @@ class InflationRun {
         m_start(now_s()) {
     m_solver.set_support_is_rigid(!has_user_fixed_vertices());
     m_settings.relative_tolerance = options.residual_tolerance;
-    m_settings.max_iterations = 60;
+    m_settings.max_iterations = ATTEMPT_NEWTON_STEPS;
     m_settings.shift_restart = options.sqp_shift_restart;
     m_settings.shift_after_cut_short = options.sqp_shift_after_cut_short;
     m_settings.cancel = options.cancel;
@@ -330,7 +332,7 @@ class InflationRun {
   /// One attempt at a volume step; one that fails creeping through wrinkles tries the sheet's bending once
   /// (try_bending_early). While that try is unused (a membrane under BendingUse::Auto), the attempt looks
   /// after CREEP_CHECK_STEPS already, so that bending is tried after 20 membrane steps rather than 60 (the
-  /// 37k-vertex bunny with silicone to x8 crept 45 membrane steps of about 1 s); unless that converged,
+  /// 37k-vertex bunny with silicone to x8 crept 45 membrane steps of about 1 s each); unless that converged,
   /// the membrane attempt goes on from where it stood to its full step budget, as the one attempt it
   /// would have been.
   bool attempt_volume_step(PathPoint& state, double target_volume, NewtonReport& report, const PathPoint* resume) {
