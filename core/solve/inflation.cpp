@@ -38,11 +38,36 @@ std::string format_number(double value) {
   return out.str();
 }
 
+/// A value short of `target`, with enough digits to show it (4.99996 short of 5 rather than "5").
+std::string format_number_short_of(double value, double target) {
+  for (int digits = 3; digits < 9; ++digits) {
+    std::ostringstream out, goal;
+    out.precision(digits);
+    goal.precision(digits);
+    out << value;
+    goal << target;
+    if (out.str() != goal.str()) return out.str();
+  }
+  return format_number(value);
+}
+
 std::string format_kpa(double mpa) {
   std::ostringstream out;
   out.precision(4);
   out << mpa / MPA_PER_KPA << " kPa";
   return out.str();
+}
+
+/// The deformed surface intersects itself while the rest surface does not (a rest mesh that already
+/// does says nothing about the inflation). A mesh CGAL cannot take is not judged.
+bool passes_through_itself(const TriMesh& rest, const Positions& deformed) {
+  try {
+    TriMesh inflated = rest;
+    inflated.vertices = deformed;
+    return mesh_self_intersects(inflated) && !mesh_self_intersects(rest);
+  } catch (const std::invalid_argument&) {
+    return false;
+  }
 }
 
 /// The continuation state of an inflation: positions, pressure and the volume they satisfy.
@@ -138,6 +163,10 @@ class InflationRun {
   /// least-squares pressure of the predicted shape rather than the last pressure. Together they save
   /// about one Newton step per curve point.
   void use_path_predictor() { m_path_predictor = true; }
+
+  /// Ends the path at the last equilibrium when that passes through itself and an attempt beyond it
+  /// fails (see stopped_passing_through_itself()).
+  void stop_where_it_passes_through_itself() { m_stop_at_self_contact = true; }
 
   /// Unstable directions of the current state under pressure control: the negative eigenvalues of the
   /// stiffness K = Hess(W - p V) over the free coordinates (0 when K is positive definite). One
@@ -294,19 +323,25 @@ class InflationRun {
     }
     int resumes_left = MAX_RESUMES;
     bool from_bent_try = false;  // the next attempt continues the early bent try (see try_bending_early)
+    bool hard_step = false;      // the last step took more than CREEP_CHECK_STEPS Newton steps
     while (std::abs(target_volume - state.volume) > 1e-14 * target_volume) {
+      if (std::exchange(hard_step, false) && stopped_passing_through_itself(state, message)) return false;
       const double next = std::abs(step) >= std::abs(target_volume - state.volume) ? target_volume : state.volume + step;
       const PathPoint* resume = std::exchange(from_bent_try, false) ? &m_bent_try_unfinished : nullptr;
+      const int newton_before = m_newton_iterations;
       if (attempt_volume_step(state, next, report, resume)) {
         if (report.iterations <= 6) step *= 2.0;
         resumes_left = MAX_RESUMES;
+        hard_step = m_newton_iterations - newton_before > CREEP_CHECK_STEPS;
         continue;
       }
+      if (report.stop != NewtonStop::Cancelled && stopped_passing_through_itself(state, message)) return false;
       while (!stopped(report) && worth_resuming(report) && resumes_left > 0) {
         --resumes_left;
         const PathPoint unfinished = m_unfinished;
         if (volume_step(state, next, report, &unfinished)) break;
       }
+      hard_step = report.converged;
       if (report.converged) continue;
       if (stopped(report)) {
         message = report.message;
@@ -405,6 +440,21 @@ class InflationRun {
     return false;
   }
 
+  /// A path that struggles has often pushed its walls through each other (the knot's tube near x3.5):
+  /// past that, this model (no contact) follows no physical balloon, and its Newton steps crept by the
+  /// hundred there. So the equilibrium a hard step reached (more than CREEP_CHECK_STEPS Newton steps),
+  /// and the one a failed attempt started from, are checked, once per state (one CGAL test, far cheaper
+  /// than such a step), and the path ends there if it passes through itself. A path that never
+  /// struggles is judged at its end only (inflate_simulated).
+  bool stopped_passing_through_itself(const PathPoint& state, std::string& message) {
+    if (!m_stop_at_self_contact || state.volume == m_self_checked_volume) return false;
+    m_self_checked_volume = state.volume;
+    if (!passes_through_itself(m_rest, unflatten(state.x))) return false;
+    m_stop = InflationStop::PassesThroughItself;
+    message = "the equilibrium at volume ratio " + format_number(state.volume / m_rest_volume) + " passes through itself";
+    return true;
+  }
+
   Eigen::VectorXd flat_rest() const {
     return Eigen::Map<const Eigen::VectorXd>(m_rest.vertices.data(), m_rest.vertices.size());
   }
@@ -423,6 +473,7 @@ class InflationRun {
     while (state.pressure < target_pressure) {
       PathPoint previous = state;
       if (!volume_step(state, state.volume + step, report)) {
+        if (report.stop != NewtonStop::Cancelled && stopped_passing_through_itself(state, message)) return false;
         if (stopped(report)) {
           message = report.message;
           return false;
@@ -510,6 +561,8 @@ class InflationRun {
   std::string m_problem;  ///< why the path cannot start; empty when it can
   std::unique_ptr<Inertia> m_inertia;  ///< made on first use
   bool m_path_predictor = false;  ///< see use_path_predictor()
+  bool m_stop_at_self_contact = false;  ///< see stop_where_it_passes_through_itself()
+  double m_self_checked_volume = 0.0;   ///< mm^3, the state stopped_passing_through_itself() last judged
   PathPoint m_previous;  ///< the equilibrium before the current state (path predictor)
 };
 
@@ -556,16 +609,12 @@ SimulationMesh simulation_mesh(const TriMesh& rest, const InflationOptions& opti
   return simulated;
 }
 
-/// The deformed surface intersects itself while the rest surface does not (a rest mesh that already
-/// does says nothing about the inflation). A mesh CGAL cannot take is not judged.
-bool passes_through_itself(const TriMesh& rest, const Positions& deformed) {
-  try {
-    TriMesh inflated = rest;
-    inflated.vertices = deformed;
-    return mesh_self_intersects(inflated) && !mesh_self_intersects(rest);
-  } catch (const std::invalid_argument&) {
-    return false;
-  }
+/// One run of the path to the options' target; with reject_self_intersection, a path that fails beyond an
+/// equilibrium passing through itself ends there.
+InflationResult run_inflation(const TriMesh& rest, const InflationOptions& options, const Positions* initial_guess) {
+  InflationRun run(rest, options);
+  if (options.reject_self_intersection) run.stop_where_it_passes_through_itself();
+  return run.run(initial_guess);
 }
 
 /// A membrane's equilibrium can pass through itself by a fold of its wrinkles (the dinosaur with latex at
@@ -578,7 +627,7 @@ std::string retry_with_bending(const TriMesh& rest, const InflationOptions& opti
   InflationOptions bent = options;
   bent.bending = BendingUse::On;
   if (options.max_time_s > 0.0) bent.max_time_s = options.max_time_s - result.time_s;
-  InflationResult second = InflationRun(rest, bent).run(initial_guess);
+  InflationResult second = run_inflation(rest, bent, initial_guess);
   InflationResult& kept = second.converged ? second : result;
   kept.newton_iterations = result.newton_iterations + second.newton_iterations;
   kept.factorizations = result.factorizations + second.factorizations;
@@ -655,20 +704,32 @@ namespace {
 /// inflate() on the simulated mesh: the run, then the answer's check against passing through itself.
 InflationResult inflate_simulated(const SimulationMesh& simulated, const Positions* initial_guess) {
   const InflationOptions& options = simulated.options;
-  InflationResult result = InflationRun(simulated.rest, options).run(initial_guess);
-  if (!result.converged || !options.reject_self_intersection || !passes_through_itself(simulated.rest, result.deformed))
+  InflationResult result = run_inflation(simulated.rest, options, initial_guess);
+  const bool on_the_way = result.stop == InflationStop::PassesThroughItself;
+  if (!on_the_way &&
+      (!result.converged || !options.reject_self_intersection || !passes_through_itself(simulated.rest, result.deformed)))
     return result;
   std::string bent_try;
   if (options.bending == BendingUse::Auto && !result.bending) {
     bent_try = retry_with_bending(simulated.rest, options, initial_guess, result);
     if (bent_try.empty() && !passes_through_itself(simulated.rest, result.deformed)) return result;
   }
+  // Still on the way (the path failed beyond it) unless the bent try replaced it with its converged end.
+  const bool short_of_target = !result.converged;
   result.converged = false;
   result.stop = InflationStop::PassesThroughItself;
+  const std::string target = options.control == InflationControl::VolumeRatio
+                                 ? "volume ratio " + format_number(options.volume_ratio)
+                                 : format_kpa(options.pressure_kpa * MPA_PER_KPA);
+  const std::string ratio = short_of_target && options.control == InflationControl::VolumeRatio
+                                ? format_number_short_of(result.volume_ratio, options.volume_ratio)
+                                : format_number(result.volume_ratio);
   result.message = std::string("no equilibrium: the ") + (result.bending ? "bent sheet's" : "membrane's") +
-                   " equilibrium at volume ratio " + format_number(result.volume_ratio) + " (" +
-                   format_kpa(result.pressure_kpa * MPA_PER_KPA) +
-                   ") passes through itself; its walls touch on the way there, and this model has no contact" +
+                   " equilibrium at volume ratio " + ratio + " (" +
+                   format_kpa(result.pressure_kpa * MPA_PER_KPA) + ")" +
+                   (short_of_target ? ", on the way to " + target + ", passes through itself; its walls touch there"
+                                    : " passes through itself; its walls touch on the way there") +
+                   ", and this model has no contact" +
                    (bent_try.empty() ? "" : "; tried again with the sheet's bending: " + bent_try);
   return result;
 }

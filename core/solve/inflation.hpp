@@ -42,6 +42,8 @@ struct InflationOptions {
   /// A converged shape whose surface passes through itself (while the rest surface does not) is no
   /// physical equilibrium: the walls would touch first, and this model has no contact. Reported as
   /// InflationStop::PassesThroughItself. Costs two CGAL self-intersection tests (~10 ms per 10k faces).
+  /// inflate() also checks the equilibria its path reached by a hard step (more than 20 Newton steps) or
+  /// failed to leave, and ends there when one passes through itself (the result says "on the way to").
   bool reject_self_intersection = true;
   /// NewtonSettings::shift_restart for this path: 1/2, for long paths through snap-throughs and wrinkles
   /// (bench_robustness: 24 -> 19 failures of 432 against 1/4). The design's start passes its own 1/4.
