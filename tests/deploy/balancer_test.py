@@ -44,19 +44,29 @@ def check(condition, message):
         fail(message)
 
 
+_handed_out = set()
+
+
 def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+    """A loopback port free now, never one handed out before: only the balancer needs a port known before it
+    binds (its config names them); the shards bind port 0 and report theirs."""
+    while True:
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", 0))
+            port = s.getsockname()[1]
+        if port not in _handed_out:
+            _handed_out.add(port)
+            return port
 
 
 class Shard:
-    """One balloon-server: gRPC and HTTP on fixed loopback ports (the balancer's config names them)."""
+    """One balloon-server: gRPC and HTTP on loopback ports it picks at its first start (port 0, read from its
+    first lines) and keeps on a restart, since the balancer's config names them."""
 
     def __init__(self, name, server, scratch, tokens, public_origin):
         self.name, self.server, self.scratch, self.tokens = name, server, scratch, tokens
         self.public_origin = public_origin  # the balancer's address: the Host the page's requests carry
-        self.grpc_port, self.http_port = free_port(), free_port()
+        self.grpc_port, self.http_port = 0, 0
         self.db = os.path.join(scratch, f"{name}.db")
         self.process = None
 
@@ -80,6 +90,10 @@ class Shard:
                 break
             output += line
         check("http on" in output, f"{self.name} did not start: {output!r}")
+        # "... listening on 127.0.0.1:PORT (...)" and "... http on 127.0.0.1:PORT (...)"
+        self.grpc_port = int(output.split("listening on ", 1)[1].split(" ", 1)[0].rsplit(":", 1)[1])
+        self.http_port = int(output.split("http on ", 1)[1].split(" ", 1)[0].rsplit(":", 1)[1])
+        _handed_out.update((self.grpc_port, self.http_port))
 
     def stop(self, sig):
         self.process.send_signal(sig)
