@@ -100,10 +100,16 @@ int main(int argc, char** argv) {
   }
   balloon::TargetPreparationOptions preparation;
   preparation.size_mm = 150.0;
-  for (int a = 3; a + 1 < argc; a += 2) {
+  for (int a = 3; a < argc; a += 2) {
     const std::string flag = argv[a];
-    if (flag == "--size") preparation.size_mm = std::atof(argv[a + 1]);
-    else if (flag == "--resolution") preparation.resolution = std::atoi(argv[a + 1]);
+    if (a + 1 < argc && flag == "--size") {
+      preparation.size_mm = std::atof(argv[a + 1]);
+    } else if (a + 1 < argc && flag == "--resolution") {
+      preparation.resolution = std::atoi(argv[a + 1]);
+    } else {
+      std::fprintf(stderr, "unknown or incomplete option: %s\n", flag.c_str());
+      return 2;
+    }
   }
   const auto raw = balloon::read_mesh(argv[1]);
   const std::string dir = argv[2];
