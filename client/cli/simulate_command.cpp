@@ -77,6 +77,17 @@ std::string format(const char* pattern, double value) {
   return buffer;
 }
 
+/// What the model added beyond the membrane, for both summaries: the sheet's bending and flipped cap slivers.
+void append_model_notes(std::ostringstream& out, bool bending, int flipped_cap_slivers) {
+  if (bending)
+    out << "  bending        on: the membrane alone wrinkled with no stable state, so the sheet's bending\n"
+           "                 stiffness (G h^3 / 3) was added\n";
+  if (flipped_cap_slivers > 0)
+    out << "  slivers        " << flipped_cap_slivers
+        << " cap sliver(s) (a vertex almost on its opposite edge) simulated with their pair's other\n"
+           "                 diagonal; no vertex moved\n";
+}
+
 /// The human summary of the service's report.
 std::string summary_from_report(const v1::SimulateReport& report) {
   std::ostringstream out;
@@ -87,13 +98,7 @@ std::string summary_from_report(const v1::SimulateReport& report) {
   if (report.unstable_modes() > 0)
     out << "  stability      a saddle under volume control: " << report.unstable_modes()
         << " unstable direction(s) (wrinkling or symmetry breaking; the real balloon may take another shape)\n";
-  if (report.bending())
-    out << "  bending        on: the membrane alone wrinkled with no stable state, so the sheet's bending\n"
-           "                 stiffness (G h^3 / 3) was added\n";
-  if (report.flipped_cap_slivers() > 0)
-    out << "  slivers        " << report.flipped_cap_slivers()
-        << " cap sliver(s) (a vertex almost on its opposite edge) simulated with their pair's other\n"
-           "                 diagonal; no vertex moved\n";
+  append_model_notes(out, report.bending(), report.flipped_cap_slivers());
   out << "  material       " << report.material();
   if (!report.material_name().empty()) out << " (" << report.material_name() << ")";
   out << ", thickness " << format("%.6g", report.thickness_mm()) << " mm\n";
@@ -166,6 +171,7 @@ std::string summary_from_curve(const v1::CurveReport& report) {
       << " points on one path (" << report.newton_iterations() << " Newton iterations, " << report.factorizations()
       << " factorizations) in " << format("%.3f", report.time_s()) << " s\n";
   if (!report.converged()) out << "  " << report.message() << "\n";
+  append_model_notes(out, report.bending(), report.flipped_cap_slivers());
   out << "  material       " << report.material();
   if (!report.material_name().empty()) out << " (" << report.material_name() << ")";
   out << ", thickness " << format("%.6g", report.thickness_mm()) << " mm, " << report.vertices() << " vertices\n";

@@ -129,6 +129,8 @@ PressureVolumeCurve trace_pressure_volume_curve(const TriMesh& rest, const Press
     curve.newton_iterations = result.newton_iterations;
     curve.factorizations = result.factorizations;
     curve.load_steps = result.load_steps;
+    curve.bending = result.bending;
+    curve.flipped_cap_slivers = result.flipped_cap_slivers;
     if (!result.converged) {
       point.message = result.message;
       curve.stop = result.stop;

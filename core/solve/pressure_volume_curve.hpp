@@ -75,6 +75,10 @@ struct PressureVolumeCurve {
   int factorizations = 0;
   int load_steps = 0;
   double time_s = 0.0;             ///< wall time of the whole path (s)
+  /// The sheet's bending stiffness was on at the path's end (InflationResult::bending: once switched on
+  /// where the membrane alone had no stable state, it stays on for the rest of the path).
+  bool bending = false;
+  int flipped_cap_slivers = 0;     ///< InflationResult::flipped_cap_slivers of the path's mesh
 };
 
 /// The targets of a curve: `points` values from `from` to `to`, in geometric progression (equal ratios).

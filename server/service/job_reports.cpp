@@ -91,6 +91,8 @@ v1::CurveReport curve_report(const jobs::SimulateInput& input, const PressureVol
   report.set_thickness_mm(input.thickness_mm);
   report.set_flipped_orientation(input.flipped_orientation);
   report.set_last_converged_point(curve.last_converged_point);
+  report.set_bending(curve.bending);
+  report.set_flipped_cap_slivers(curve.flipped_cap_slivers);
   return report;
 }
 

@@ -9,6 +9,8 @@
 #include <sstream>
 
 #include "cli_test_support.hpp"
+#include "core/mesh/mesh_test_helpers.hpp"
+#include "mesh/mesh_io.hpp"
 
 namespace balloon::testing {
 namespace {
@@ -89,6 +91,17 @@ TEST_F(CurveCommand, LatexToTwoHundredFiftyWritesTheCsvAndThePlotIntoTheFolderOf
   EXPECT_EQ(count(svg, "class=\"pressure-minimum\""), 1u) << svg;
   EXPECT_TRUE(std::filesystem::exists(folder / "final.obj"));
   EXPECT_NE(result.out.find("pressure maximum"), std::string::npos) << result.out;
+}
+
+// A mesh with a cap sliver: the summary says the path simulated it flipped, as a single simulate's does.
+TEST_F(CurveCommand, TheSummarySaysWhatTheModelAddedBeyondTheMembrane) {
+  const std::string mesh = s_scratch->file("sliver.obj");
+  ASSERT_TRUE(balloon::write_mesh(balloon::test::sphere_with_cap_sliver(10.0, 2, 0.001), mesh).ok());
+  const ProcessResult result = run({"simulate", mesh, "--material", "silicone", "--volume-ratio-range", "1.5:3",
+                                    "--points", "2", "--out", s_scratch->path().string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err << result.out;
+  EXPECT_NE(result.out.find("slivers        1 cap sliver(s)"), std::string::npos) << result.out;
+  EXPECT_EQ(result.out.find("bending        on"), std::string::npos) << result.out;
 }
 
 // --json: one line with every point (the CSV's columns by name) and the extrema; the Neo-Hookean maximum

@@ -121,10 +121,10 @@ inline TriMesh sphere_with_needle_slivers(double radius, int subdivisions, doubl
 /// True if `actual` is `expected` up to vertex renumbering: every vertex has a partner within
 /// relative_tolerance * bounding-box diagonal and the faces map onto the same oriented triangles.
 /// Brute force: for small meshes only.
-inline testing::AssertionResult same_geometry(const TriMesh& expected, const TriMesh& actual,
+inline ::testing::AssertionResult same_geometry(const TriMesh& expected, const TriMesh& actual,
                                               double relative_tolerance) {
   if (expected.vertex_count() != actual.vertex_count() || expected.face_count() != actual.face_count()) {
-    return testing::AssertionFailure() << "counts differ: expected " << expected.vertex_count() << " / "
+    return ::testing::AssertionFailure() << "counts differ: expected " << expected.vertex_count() << " / "
                                        << expected.face_count() << ", got " << actual.vertex_count()
                                        << " / " << actual.face_count();
   }
@@ -139,7 +139,7 @@ inline testing::AssertionResult same_geometry(const TriMesh& expected, const Tri
       if (d < best_distance) best_distance = d, best = j;
     }
     if (!(best_distance <= tolerance)) {
-      return testing::AssertionFailure() << "vertex " << i << " has no partner within " << tolerance
+      return ::testing::AssertionFailure() << "vertex " << i << " has no partner within " << tolerance
                                          << " (nearest " << best_distance << ")";
     }
     worst = std::max(worst, best_distance);
@@ -159,9 +159,9 @@ inline testing::AssertionResult same_geometry(const TriMesh& expected, const Tri
     const auto mapped = canonical(partner[static_cast<std::size_t>(expected.faces(f, 0))],
                                   partner[static_cast<std::size_t>(expected.faces(f, 1))],
                                   partner[static_cast<std::size_t>(expected.faces(f, 2))]);
-    if (!actual_faces.count(mapped)) return testing::AssertionFailure() << "face " << f << " is missing";
+    if (!actual_faces.count(mapped)) return ::testing::AssertionFailure() << "face " << f << " is missing";
   }
-  return testing::AssertionSuccess() << "largest vertex distance " << worst;
+  return ::testing::AssertionSuccess() << "largest vertex distance " << worst;
 }
 
 }  // namespace balloon::test

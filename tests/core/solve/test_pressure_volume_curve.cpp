@@ -5,8 +5,11 @@
 #include <cmath>
 
 #include "material/homogeneous_tests.hpp"
+#include "material/material.hpp"
 #include "mesh/icosphere.hpp"
 #include "mesh/mesh_geometry.hpp"
+#include "mesh/mesh_io.hpp"
+#include "core/mesh/mesh_test_helpers.hpp"
 #include "solve/pressure_volume_curve.hpp"
 
 namespace balloon {
@@ -153,6 +156,24 @@ TEST(PressureVolumeCurve, BadRangesAreReportedNotThrown) {
   EXPECT_NE(curve.message.find("thickness"), std::string::npos) << curve.message;
   ASSERT_EQ(curve.points.size(), 3u);
   for (const CurvePoint& point : curve.points) EXPECT_FALSE(point.converged || point.pressure_kpa);
+}
+
+TEST(PressureVolumeCurve, SaysWhatTheModelAddedBeyondTheMembrane) {
+  // A cap sliver is simulated flipped, and the femur (200 mm, silicone) wrinkles with no stable membrane
+  // state on its way to x2, so the sheet's bending goes on; the curve's report says both, as inflate()'s does.
+  const PressureVolumeCurve sliver =
+      trace_pressure_volume_curve(test::sphere_with_cap_sliver(50.0, 2, 0.001), volume_curve(make(MaterialModel::NeoHookean, 0.3), 1.5, 3.0, 2));
+  ASSERT_TRUE(sliver.converged) << sliver.message;
+  EXPECT_EQ(sliver.flipped_cap_slivers, 1);
+  EXPECT_FALSE(sliver.bending);
+
+  auto femur = read_mesh(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/femur.off");
+  ASSERT_TRUE(femur.ok()) << femur.error();
+  femur->vertices *= 200.0 / bounding_box_diagonal(femur->vertices);
+  const PressureVolumeCurve bent = trace_pressure_volume_curve(*femur, volume_curve(*parse_material_spec("silicone"), 1.5, 2.0, 2));
+  ASSERT_TRUE(bent.converged) << bent.message;
+  EXPECT_TRUE(bent.bending);
+  EXPECT_EQ(bent.flipped_cap_slivers, 0);
 }
 
 }  // namespace
