@@ -451,7 +451,8 @@ class InflationRun {
     m_self_checked_volume = state.volume;
     if (!passes_through_itself(m_rest, unflatten(state.x))) return false;
     m_stop = InflationStop::PassesThroughItself;
-    message = "the equilibrium at volume ratio " + format_number(state.volume / m_rest_volume) + " passes through itself";
+    message =
+        "the equilibrium at volume ratio " + format_number(state.volume / m_rest_volume) + " passes through itself";
     return true;
   }
 
@@ -706,9 +707,9 @@ InflationResult inflate_simulated(const SimulationMesh& simulated, const Positio
   const InflationOptions& options = simulated.options;
   InflationResult result = run_inflation(simulated.rest, options, initial_guess);
   const bool on_the_way = result.stop == InflationStop::PassesThroughItself;
-  if (!on_the_way &&
-      (!result.converged || !options.reject_self_intersection || !passes_through_itself(simulated.rest, result.deformed)))
-    return result;
+  const bool ended_through_itself = result.converged && options.reject_self_intersection &&
+                                    passes_through_itself(simulated.rest, result.deformed);
+  if (!on_the_way && !ended_through_itself) return result;
   std::string bent_try;
   if (options.bending == BendingUse::Auto && !result.bending) {
     bent_try = retry_with_bending(simulated.rest, options, initial_guess, result);

@@ -95,7 +95,8 @@ std::vector<bool> compressed_vertices(const TriMesh& rest, const Positions& infl
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::fprintf(stderr, "usage: design_error_by_region TARGET_MESH DESIGN_DIR [--size MM=150] [--resolution N=4000]\n");
+    std::fprintf(stderr,
+                 "usage: design_error_by_region TARGET_MESH DESIGN_DIR [--size MM=150] [--resolution N=4000]\n");
     return 2;
   }
   balloon::TargetPreparationOptions preparation;
@@ -121,7 +122,8 @@ int main(int argc, char** argv) {
   }
   const auto prepared = balloon::prepare_target(*raw, preparation);
   if (!prepared || prepared->mesh.vertex_count() != inflated->vertex_count()) {
-    std::fprintf(stderr, "the prepared target does not match the design's connectivity (other --size or --resolution?)\n");
+    std::fprintf(stderr,
+                 "the prepared target does not match the design's connectivity (other --size or --resolution?)\n");
     return 1;
   }
   const TriMesh& target = prepared->mesh;

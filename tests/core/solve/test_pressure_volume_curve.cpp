@@ -161,8 +161,8 @@ TEST(PressureVolumeCurve, BadRangesAreReportedNotThrown) {
 TEST(PressureVolumeCurve, SaysWhatTheModelAddedBeyondTheMembrane) {
   // A cap sliver is simulated flipped, and the femur (200 mm, silicone) wrinkles with no stable membrane
   // state on its way to x2, so the sheet's bending goes on; the curve's report says both, as inflate()'s does.
-  const PressureVolumeCurve sliver =
-      trace_pressure_volume_curve(test::sphere_with_cap_sliver(50.0, 2, 0.001), volume_curve(make(MaterialModel::NeoHookean, 0.3), 1.5, 3.0, 2));
+  const PressureVolumeCurve sliver = trace_pressure_volume_curve(
+      test::sphere_with_cap_sliver(50.0, 2, 0.001), volume_curve(make(MaterialModel::NeoHookean, 0.3), 1.5, 3.0, 2));
   ASSERT_TRUE(sliver.converged) << sliver.message;
   EXPECT_EQ(sliver.flipped_cap_slivers, 1);
   EXPECT_FALSE(sliver.bending);
@@ -170,7 +170,8 @@ TEST(PressureVolumeCurve, SaysWhatTheModelAddedBeyondTheMembrane) {
   auto femur = read_mesh(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/femur.off");
   ASSERT_TRUE(femur.ok()) << femur.error();
   femur->vertices *= 200.0 / bounding_box_diagonal(femur->vertices);
-  const PressureVolumeCurve bent = trace_pressure_volume_curve(*femur, volume_curve(*parse_material_spec("silicone"), 1.5, 2.0, 2));
+  const PressureVolumeCurve bent =
+      trace_pressure_volume_curve(*femur, volume_curve(*parse_material_spec("silicone"), 1.5, 2.0, 2));
   ASSERT_TRUE(bent.converged) << bent.message;
   EXPECT_TRUE(bent.bending);
   EXPECT_EQ(bent.flipped_cap_slivers, 0);
