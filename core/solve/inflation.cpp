@@ -164,10 +164,6 @@ class InflationRun {
   /// about one Newton step per curve point.
   void use_path_predictor() { m_path_predictor = true; }
 
-  /// Ends the path at the last equilibrium when that passes through itself and an attempt beyond it
-  /// fails (see stopped_passing_through_itself()).
-  void stop_where_it_passes_through_itself() { m_stop_at_self_contact = true; }
-
   /// Unstable directions of the current state under pressure control: the negative eigenvalues of the
   /// stiffness K = Hess(W - p V) over the free coordinates (0 when K is positive definite). One
   /// supernodal LL^T; the LDL^T for the inertia only when that fails. -1 when K is singular.
@@ -447,7 +443,7 @@ class InflationRun {
   /// than such a step), and the path ends there if it passes through itself. A path that never
   /// struggles is judged at its end only (inflate_simulated).
   bool stopped_passing_through_itself(const PathPoint& state, std::string& message) {
-    if (!m_stop_at_self_contact || state.volume == m_self_checked_volume) return false;
+    if (!m_options.reject_self_intersection || state.volume == m_self_checked_volume) return false;
     m_self_checked_volume = state.volume;
     if (!passes_through_itself(m_rest, unflatten(state.x))) return false;
     m_stop = InflationStop::PassesThroughItself;
@@ -562,7 +558,6 @@ class InflationRun {
   std::string m_problem;  ///< why the path cannot start; empty when it can
   std::unique_ptr<Inertia> m_inertia;  ///< made on first use
   bool m_path_predictor = false;  ///< see use_path_predictor()
-  bool m_stop_at_self_contact = false;  ///< see stop_where_it_passes_through_itself()
   double m_self_checked_volume = 0.0;   ///< mm^3, the state stopped_passing_through_itself() last judged
   PathPoint m_previous;  ///< the equilibrium before the current state (path predictor)
 };
@@ -610,14 +605,6 @@ SimulationMesh simulation_mesh(const TriMesh& rest, const InflationOptions& opti
   return simulated;
 }
 
-/// One run of the path to the options' target; with reject_self_intersection, a path that fails beyond an
-/// equilibrium passing through itself ends there.
-InflationResult run_inflation(const TriMesh& rest, const InflationOptions& options, const Positions* initial_guess) {
-  InflationRun run(rest, options);
-  if (options.reject_self_intersection) run.stop_where_it_passes_through_itself();
-  return run.run(initial_guess);
-}
-
 /// A membrane's equilibrium can pass through itself by a fold of its wrinkles (the dinosaur with latex at
 /// x27: its limbs), which the sheet's bending smooths out: tried once more, from the start, with bending
 /// on and the budget left. A converged bent result replaces `result` (the counters add up either way);
@@ -628,7 +615,7 @@ std::string retry_with_bending(const TriMesh& rest, const InflationOptions& opti
   InflationOptions bent = options;
   bent.bending = BendingUse::On;
   if (options.max_time_s > 0.0) bent.max_time_s = options.max_time_s - result.time_s;
-  InflationResult second = run_inflation(rest, bent, initial_guess);
+  InflationResult second = InflationRun(rest, bent).run(initial_guess);
   InflationResult& kept = second.converged ? second : result;
   kept.newton_iterations = result.newton_iterations + second.newton_iterations;
   kept.factorizations = result.factorizations + second.factorizations;
@@ -675,6 +662,8 @@ InflationPath::InflationPath(const TriMesh& rest, const InflationOptions& option
   // The targets are checked per advance; give options_problem harmless ones.
   checked.control = InflationControl::VolumeRatio;
   checked.volume_ratio = 1.0;
+  // A curve reports every point it reaches; whether one passes through itself is not judged along it.
+  checked.reject_self_intersection = false;
   m = std::make_unique<Impl>(rest, checked);
   if (m->run) m->problem = m->run->start(initial_guess);
 }
@@ -705,7 +694,7 @@ namespace {
 /// inflate() on the simulated mesh: the run, then the answer's check against passing through itself.
 InflationResult inflate_simulated(const SimulationMesh& simulated, const Positions* initial_guess) {
   const InflationOptions& options = simulated.options;
-  InflationResult result = run_inflation(simulated.rest, options, initial_guess);
+  InflationResult result = InflationRun(simulated.rest, options).run(initial_guess);
   const bool on_the_way = result.stop == InflationStop::PassesThroughItself;
   const bool ended_through_itself = result.converged && options.reject_self_intersection &&
                                     passes_through_itself(simulated.rest, result.deformed);

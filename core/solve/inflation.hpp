@@ -102,7 +102,8 @@ InflationResult inflate(const TriMesh& rest, const InflationOptions& options,
 /// reuses the model, the sparsity pattern and CHOLMOD's analysis (the pressure-volume curve's path).
 class InflationPath {
  public:
-  /// `options` as for inflate(); its control and targets are ignored (each advance names its own).
+  /// `options` as for inflate(); its control and targets are ignored (each advance names its own), and so is
+  /// reject_self_intersection (no point of the path is judged for passing through itself).
   /// `initial_guess` as for inflate().
   InflationPath(const TriMesh& rest, const InflationOptions& options, const Positions* initial_guess = nullptr);
   ~InflationPath();

@@ -69,7 +69,8 @@ VertexCurvature vertex_curvature(const TriMesh& mesh) {
   return out;
 }
 
-/// Triangles whose smaller principal stress is negative for a Neo-Hookean sheet (lambda_2 < lambda_1^-1/2).
+/// Per vertex: whether a triangle around it is compressed, i.e. its smaller principal stress is negative for a
+/// Neo-Hookean sheet (lambda_2 < lambda_1^-1/2).
 std::vector<bool> compressed_vertices(const TriMesh& rest, const Positions& inflated) {
   std::vector<bool> touched(static_cast<size_t>(rest.vertex_count()), false);
   for (int f = 0; f < rest.face_count(); ++f) {
