@@ -7,7 +7,8 @@
 //
 // It loads the page, designs a balloon for the sample cube (about 400 vertices, 10 s budget), sees
 // progress events arrive and the job complete, checks that the viewer drew the shape, downloads
-// rest.obj and parses it, checks that a refused thickness is shown under the thickness input and a bad
+// rest.obj and parses it, starts the designed balloon's pressure-volume curve and sees its plot, checks
+// that a refused thickness is shown under the thickness input and a bad
 // upload (dropped on the drop zone) next to the upload control: the server's errors are placed by the
 // field path they name (the API's error.fields), whatever their words.
 // Every request leaving loopback is aborted and recorded, and the test fails if there was any.
@@ -354,6 +355,35 @@ async function run(options) {
     const rest = parse_obj_strictly(readFileSync(rest_path, 'utf8'));
     check('rest.obj downloads and parses', download.suggestedFilename() === 'rest.obj' && rest.vertices > 0 && rest.faces > 0 && rest.problems.length === 0,
       `${download.suggestedFilename()}: ${rest.vertices} vertices, ${rest.faces} faces${rest.problems.length ? `; problems: ${rest.problems.slice(0, 3).join('; ')}` : ''}`);
+
+    // 6b. The designed balloon's pressure-volume curve: started from the page as a curve job, followed in
+    // the job panel, its plot (curve.svg) shown with the summary's count of converged equilibria.
+    await page.click('#curve-button');
+    await page.waitForFunction((design_id) => {
+      const id = document.getElementById('job-panel').dataset.jobId;
+      return id !== '' && id !== design_id;
+    }, job_id, { timeout: 20000 }).catch(() => {});
+    const curve_state = await page.waitForFunction(() => {
+      const state = document.getElementById('job-panel').dataset.state;
+      return state === 'JOB_STATE_COMPLETED' || state === 'JOB_STATE_FAILED' || state === 'JOB_STATE_CANCELLED' ? state : null;
+    }, null, { timeout: 60000 }).then((handle) => handle.jsonValue()).catch(() => 'timeout');
+    await page.waitForFunction(() => {
+      const plot = document.getElementById('curve-plot');
+      return !document.getElementById('curve-figure').hidden && plot.complete && plot.naturalWidth > 0;
+    }, null, { timeout: 20000 }).catch(() => {});
+    const curve = await page.evaluate(() => ({
+      job: document.getElementById('job-panel').dataset.jobId,
+      shown: !document.getElementById('curve-figure').hidden,
+      width: document.getElementById('curve-plot').naturalWidth,
+      summary: document.getElementById('result-summary').textContent,
+      errors: `${document.getElementById('curve-error').textContent} ${document.getElementById('job-error').textContent}`.trim(),
+    }));
+    check('curve of the design: a curve job completes and its plot is shown',
+      curve.job !== job_id && curve_state === 'JOB_STATE_COMPLETED' && curve.shown && curve.width > 0 &&
+        /\d+ of \d+ equilibria converged/.test(curve.summary),
+      `job ${curve.job}: ${curve_state}; plot ${curve.shown ? `${curve.width} px wide` : 'not shown'}; ` +
+        `${curve.summary.trim().slice(0, 300)} ${curve.errors}`.trim());
+    await screenshot('curve');
 
     // 7. A thickness the server refuses (the page checks only that it is a number): the server's description
     // of the field "design.thickness_mm" appears under the thickness input, and nowhere else.

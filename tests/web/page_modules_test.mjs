@@ -14,6 +14,8 @@ import { ordered_params, param_label } from '../../client/web/src/material_param
 import { SurfaceDistance } from '../../client/web/src/surface_distance.js';
 import { ApiClient, ApiError, base64_from_bytes, bytes_from_base64 } from '../../client/web/src/api_client.js';
 import { format_error_mm } from '../../client/web/src/format.js';
+import { CURVE_FIRST_RATIO, CURVE_LAST_RATIO_CAP, CURVE_POINTS, curve_spec_for_design } from '../../client/web/src/curve_request.js';
+import { curve_summary_lines } from '../../client/web/src/curve_summary.js';
 
 test('SSE parser: events split across chunks, CRLF, comments and multi-line data', () => {
   const parser = new SseParser();
@@ -190,4 +192,39 @@ test('an error that was never computed (null) shows as a dash, not 0', () => {
   assert.equal(format_error_mm(-1), '–');
   assert.notEqual(format_error_mm(0), '–');
   assert.notEqual(format_error_mm(0.25), '–');
+});
+
+test('curve of a design: its rest mesh, material SPEC and thickness, to twice its volume ratio', () => {
+  const result = {
+    rest_mesh: { data: 'cmVzdA==', format: 'obj' },
+    design_report: { volume_ratio: 8, material: 'hart-smith:G=0.12,k1=0.0005,k2=0.8', material_name: 'silicone', thickness_mm: 0.7 },
+  };
+  const spec = curve_spec_for_design(result);
+  assert.deepEqual(spec.simulate.rest_mesh, { data: 'cmVzdA==', format: 'obj' });
+  assert.deepEqual(spec.simulate.material, { spec: 'hart-smith:G=0.12,k1=0.0005,k2=0.8' });
+  assert.equal(spec.simulate.thickness_mm, 0.7);
+  assert.deepEqual(spec.simulate.curve.volume_ratio_range, { from: CURVE_FIRST_RATIO, to: 16 });
+  assert.equal(spec.simulate.curve.points, CURVE_POINTS);
+  result.design_report.volume_ratio = 100;
+  assert.equal(curve_spec_for_design(result).simulate.curve.volume_ratio_range.to, CURVE_LAST_RATIO_CAP);
+  // No designed balloon: no inflation (start_failed: volume_ratio absent), no rest mesh, no report.
+  assert.throws(() => curve_spec_for_design({ ...result, design_report: { ...result.design_report, volume_ratio: undefined } }),
+    /never inflated/);
+  assert.throws(() => curve_spec_for_design({ design_report: result.design_report }), /no designed balloon/);
+  assert.throws(() => curve_spec_for_design({ simulate_report: {} }), /no designed balloon/);
+});
+
+test('curve summary: converged count, range and each extremum in words; no maximum said so', () => {
+  const report = {
+    control: 'volume_ratio', range_from: 1.01, range_to: 16, vertices: 400, material_name: 'latex', thickness_mm: 0.5,
+    points: [{ converged: true }, { converged: true }, { converged: true }, { converged: false }],
+    extrema: [{ kind: 'maximum', volume_ratio: 2.43, pressure_kpa: 3.21 }, { kind: 'minimum', volume_ratio: 9.1, pressure_kpa: 2.2 }],
+  };
+  const lines = curve_summary_lines(report);
+  assert.match(lines[0], /^3 of 4 equilibria converged, volume ratio 1\.01 to 16; 400 vertices; latex, 0\.5 mm thick\.$/);
+  assert.match(lines[1], /^Pressure maximum: 3\.21 kPa at volume ratio 2\.43\. .*snaps/);
+  assert.match(lines[2], /^Pressure minimum: 2\.2 kPa at volume ratio 9\.1\./);
+  assert.equal(lines.length, 3);
+  const rising = curve_summary_lines({ ...report, extrema: [] });
+  assert.match(rising[1], /^No pressure maximum up to where the curve stopped/);
 });

@@ -4,6 +4,7 @@
 import { bytes_from_base64 } from './api_client.js';
 import { save_blob } from './blob_download.js';
 import { colors_for_distances, nice_upper_bound, ramp_css_gradient } from './color_map.js';
+import { curve_summary_lines } from './curve_summary.js';
 import { show_error } from './field_errors.js';
 import { format_error_mm, format_number, is_active_state, kind_label, state_label } from './format.js';
 import { parse_obj } from './obj_parser.js';
@@ -30,9 +31,10 @@ export class JobPanel {
    * @param {import('./error_plot.js').ErrorPlot} plot
    * @param {object} elements  panel, job_id, state, readouts {iteration, elapsed, avg_error, max_error,
    *   pressure, vertices}, summary, error, downloads (container), download_error, cancel_button,
-   *   legend {min, max, bar, caption}, viewer_message
+   *   legend {min, max, bar, caption}, viewer_message, curve_figure, curve_plot (an img), curve_button,
+   *   curve_error
    * @param {object} hooks  on_change(job_id, state): the list should refresh; on_fit_job(job_id): show a
-   *   completed fit in the fit panel
+   *   completed fit in the fit panel; on_curve(result): start the curve of the design whose JobResult it is
    */
   constructor(api, viewer, plot, elements, hooks) {
     this.m_api = api;
@@ -52,7 +54,12 @@ export class JobPanel {
     this.m_event_count = 0;
     this.m_mesh_frames = 0;
     this.m_needs_new_mesh = true;
+    this.m_design_result = null;
+    this.m_curve_url = '';
     elements.legend.bar.style.background = ramp_css_gradient();
+    elements.curve_button.addEventListener('click', () => {
+      if (this.m_design_result) this.m_hooks.on_curve(this.m_design_result);
+    });
     for (const button of elements.downloads.querySelectorAll('button[data-file]'))
       button.addEventListener('click', () => this.download(button.dataset.file, button));
     elements.cancel_button.addEventListener('click', () => this.cancel());
@@ -89,6 +96,10 @@ export class JobPanel {
     show_error(elements.download_error, '');
     this.set_downloads([]);
     elements.cancel_button.disabled = true;
+    this.m_design_result = null;
+    elements.curve_button.hidden = true;
+    show_error(elements.curve_error, '');
+    this.clear_curve_plot();
     this.update_dataset();
     if (this.m_viewer) {
       this.m_viewer.clear('rest');
@@ -352,7 +363,7 @@ export class JobPanel {
     }
     if (this.m_job_id !== job.id) return;
     // The typed report of the job's kind (the gateway's JSON of JobResult); an error never computed is absent.
-    const report = result.design_report ?? result.simulate_report ?? {};
+    const report = result.design_report ?? result.simulate_report ?? result.curve_report ?? {};
     // The report knows the exact scale the server applied to the target.
     const scale = report.preparation?.scale_factor;
     if (this.m_target && this.m_target.mesh && Number.isFinite(scale) && scale > 0 && scale !== this.m_target.scale)
@@ -379,6 +390,35 @@ export class JobPanel {
       this.m_plot.set_points(convergence.time_s, convergence.avg_error_mm ?? []);
     this.show_summary(job, report);
     this.set_downloads(FILES_BY_KIND[job.kind] ?? []);
+    // A designed balloon (one whose start inflated) can have its pressure-volume curve computed.
+    if (job.kind === 'JOB_KIND_DESIGN' && report.volume_ratio != null) {
+      this.m_design_result = result;
+      this.m_elements.curve_button.hidden = false;
+    }
+    if (result.curve_report) await this.show_curve_plot(job);
+  }
+
+  /** A curve job's plot (curve.svg, pressure maxima and minima marked) under the summary. */
+  async show_curve_plot(job) {
+    const { curve_figure, curve_plot } = this.m_elements;
+    try {
+      const blob = await this.m_api.fetch_file(job.id, 'curve.svg');
+      if (this.m_job_id !== job.id) return;
+      this.clear_curve_plot();
+      this.m_curve_url = URL.createObjectURL(blob);
+      curve_plot.src = this.m_curve_url;
+      curve_figure.hidden = false;
+    } catch (error) {
+      show_error(this.m_elements.error, `The curve's plot could not be loaded: ${error.message}`);
+    }
+  }
+
+  clear_curve_plot() {
+    const { curve_figure, curve_plot } = this.m_elements;
+    if (this.m_curve_url) URL.revokeObjectURL(this.m_curve_url);
+    this.m_curve_url = '';
+    curve_plot.removeAttribute('src');
+    curve_figure.hidden = true;
   }
 
   show_summary(job, report) {
@@ -391,9 +431,11 @@ export class JobPanel {
 
     const lines = [];
     const converged = report.converged ?? job.converged;
+    // The stop word and the sentence only where they add to "converged".
+    const stop = report.stop_reason && report.stop_reason !== 'converged' ? report.stop_reason : '';
+    const message = report.message && report.message !== 'converged' && report.message !== stop ? report.message : '';
     lines.push(`${kind_label(job.kind)} ${converged ? 'converged' : 'stopped before converging'}` +
-      (report.stop_reason ? ` [${report.stop_reason.replace('_', ' ')}]` : '') +
-      (report.message ? ` (${report.message})` : ''));
+      (stop ? ` [${stop.replace('_', ' ')}]` : '') + (message ? ` (${message})` : ''));
     if (job.kind === 'JOB_KIND_DESIGN' && report.avg_error_mm == null)
       lines.push('No design error: the start shape was never inflated, so there is nothing to compare.');
     if (report.avg_error_mm != null)
@@ -406,6 +448,7 @@ export class JobPanel {
       lines.push(`Inflate to ${format_number(report.pressure_kpa, 4)} kPa; volume ratio ${format_number(report.volume_ratio, 4)}; ` +
         `${report.vertices ?? '?'} vertices; ${report.material_name || report.material || ''}, ${format_number(report.thickness_mm, 3)} mm thick.`);
     if (report.mold_problem) lines.push(`No mold: ${report.mold_problem}`);
+    if (job.kind === 'JOB_KIND_CURVE') lines.push(...curve_summary_lines(report));
     summary.replaceChildren(...lines.map((line) => {
       const paragraph = document.createElement('p');
       paragraph.textContent = line;

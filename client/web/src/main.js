@@ -4,6 +4,7 @@ import { ApiClient } from './api_client.js';
 import { base64_from_bytes } from './api_client.js';
 import { DesignForm } from './design_form.js';
 import { ErrorPlot } from './error_plot.js';
+import { curve_spec_for_design } from './curve_request.js';
 import { clear_errors, show_error, show_field_errors } from './field_errors.js';
 import { FitPanel } from './fit_panel.js';
 import { JobList } from './job_list.js';
@@ -91,9 +92,12 @@ const job_panel = new JobPanel(api, viewer, plot, {
   summary: $('result-summary'), error: $('job-error'), downloads: document.querySelector('.downloads'),
   download_error: $('download-error'), cancel_button: $('cancel-button'), viewer_message: $('viewer-message'),
   legend: { min: $('legend-min'), max: $('legend-max'), bar: $('legend-bar'), caption: $('legend-caption') },
+  curve_figure: $('curve-figure'), curve_plot: $('curve-plot'), curve_button: $('curve-button'),
+  curve_error: $('curve-error'),
 }, {
   on_change: () => job_list.refresh(),
   on_fit_job: (job_id) => fit_panel.show_result(job_id).catch((error) => show_error($('fit-error'), error.message)),
+  on_curve: start_curve,
 });
 
 const job_list = new JobList(api, { rows: $('job-rows'), error: $('jobs-error'), refresh: $('jobs-refresh') }, {
@@ -190,6 +194,33 @@ function show_design_error(error) {
 }
 
 $('start-button').addEventListener('click', start_design);
+
+// ----- the designed balloon's pressure-volume curve ---------------------------------------------------
+
+/** Submits the curve of a completed design (its JobResult) and follows it in the job panel. */
+async function start_curve(design_result) {
+  const button = $('curve-button');
+  show_error($('curve-error'), '');
+  let spec;
+  try {
+    spec = curve_spec_for_design(design_result);
+  } catch (error) {
+    show_error($('curve-error'), `No curve: ${error.message}`);
+    return;
+  }
+  button.disabled = true;
+  try {
+    const job = await api.submit_job(spec);
+    // The curve's shapes are the balloon's own inflation, not a match to the target: no target overlay.
+    job_panel.follow_new(job, null);
+    job_list.current_id = job.id;
+    job_list.refresh();
+  } catch (error) {
+    show_error($('curve-error'), `The curve was not started: ${error.message}`);
+  } finally {
+    button.disabled = false;
+  }
+}
 
 // ----- job list actions -----------------------------------------------------------------------------
 
