@@ -185,6 +185,7 @@ class EquilibriumSolver {
   int m_sqp_unshifted_steps = 0;        ///< consecutive unshifted SQP steps: close enough for the exact step
   bool m_last_step_exact = false;  ///< the last volume step was the exact one
   bool m_exact_indefinite = false;  ///< the last exact stiffness had negative pivots: skip the LL^T attempt
+  bool m_sqp_indefinite = false;    ///< the last SQP model factorized had negative pivots: likewise
   double m_force_floor = 0.0;  ///< N, see force_scale()
   std::vector<int> m_support;  ///< the held coordinates, when they are a rigid support; else empty
 };
