@@ -149,6 +149,16 @@ export class ApiClient {
   }
 
   /**
+   * A result's SVG plot (fit.svg, curve.svg) as an object URL for an <img>, re-typed image/svg+xml so that
+   * it renders whatever Content-Type the server sent. The caller revokes it (URL.revokeObjectURL).
+   * @returns {Promise<string>}
+   */
+  async fetch_svg_url(job_id, file_name) {
+    const text = await (await this.fetch_file(job_id, file_name)).text();
+    return URL.createObjectURL(new Blob([text], { type: 'image/svg+xml' }));
+  }
+
+  /**
    * Streams a job's events until the job finishes (Server-Sent Events read with fetch so the token can
    * be sent).
    * @param {string} job_id

@@ -110,10 +110,9 @@ export class FitPanel {
         `(${format_number(100 * (fit.rms_relative_residual ?? NaN), 3)} %)`;
       row.insertCell().textContent = String(fit.points ?? '–');
     }
-    // Re-typed so <img> renders it as SVG whatever Content-Type the server sent.
-    const svg = new Blob([await (await this.m_api.fetch_file(job_id, 'fit.svg')).text()], { type: 'image/svg+xml' });
+    const url = await this.m_api.fetch_svg_url(job_id, 'fit.svg');
     if (this.m_plot_url) URL.revokeObjectURL(this.m_plot_url);
-    this.m_plot_url = URL.createObjectURL(svg);
+    this.m_plot_url = url;
     elements.plot.src = this.m_plot_url;
     elements.result.hidden = false;
   }

@@ -402,11 +402,14 @@ export class JobPanel {
   async show_curve_plot(job) {
     const { curve_figure, curve_plot } = this.m_elements;
     try {
-      const blob = await this.m_api.fetch_file(job.id, 'curve.svg');
-      if (this.m_job_id !== job.id) return;
+      const url = await this.m_api.fetch_svg_url(job.id, 'curve.svg');
+      if (this.m_job_id !== job.id) {
+        URL.revokeObjectURL(url);
+        return;
+      }
       this.clear_curve_plot();
-      this.m_curve_url = URL.createObjectURL(blob);
-      curve_plot.src = this.m_curve_url;
+      this.m_curve_url = url;
+      curve_plot.src = url;
       curve_figure.hidden = false;
     } catch (error) {
       show_error(this.m_elements.error, `The curve's plot could not be loaded: ${error.message}`);

@@ -199,13 +199,13 @@ $('start-button').addEventListener('click', start_design);
 
 /** Submits the curve of a completed design (its JobResult) and follows it in the job panel. */
 async function start_curve(design_result) {
-  const button = $('curve-button');
-  show_error($('curve-error'), '');
+  const { curve_button: button, curve_error: error_line } = job_panel.elements;
+  show_error(error_line, '');
   let spec;
   try {
     spec = curve_spec_for_design(design_result);
   } catch (error) {
-    show_error($('curve-error'), `No curve: ${error.message}`);
+    show_error(error_line, `No curve: ${error.message}`);
     return;
   }
   button.disabled = true;
@@ -216,7 +216,7 @@ async function start_curve(design_result) {
     job_list.current_id = job.id;
     job_list.refresh();
   } catch (error) {
-    show_error($('curve-error'), `The curve was not started: ${error.message}`);
+    show_error(error_line, `The curve was not started: ${error.message}`);
   } finally {
     button.disabled = false;
   }
