@@ -13,6 +13,10 @@
 #include "mesh/mesh_io.hpp"
 
 int main(int argc, char** argv) {
+  const auto usage = [] {
+    std::fprintf(stderr, "usage: generate_shapes OUT_DIR [--seed N] [--size S]\n");
+    return 2;
+  };
   std::string out_dir;
   unsigned seed = 1;
   double size = 0.03;
@@ -25,13 +29,11 @@ int main(int argc, char** argv) {
     } else if (!arg.empty() && arg[0] != '-' && out_dir.empty()) {
       out_dir = arg;
     } else {
-      std::fprintf(stderr, "usage: generate_shapes OUT_DIR [--seed N] [--size S]\n");
-      return 2;
+      return usage();
     }
   }
   if (out_dir.empty() || !(size > 0.0)) {
-    std::fprintf(stderr, "usage: generate_shapes OUT_DIR [--seed N] [--size S]\n");
-    return 2;
+    return usage();
   }
   const std::filesystem::path meshes = std::filesystem::path(out_dir) / "meshes";
   std::filesystem::create_directories(meshes);

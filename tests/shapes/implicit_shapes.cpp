@@ -14,6 +14,8 @@
 #include <functional>
 #include <random>
 
+#include "mesh/mesh_geometry.hpp"
+
 namespace balloon::test_shapes {
 namespace {
 
@@ -172,17 +174,13 @@ bool mesh_field(const Field& field, double size, TriMesh& out) {
     out.vertices.row(static_cast<Eigen::Index>(v)) << p.x(), p.y(), p.z();
   }
   out.faces.resize(static_cast<Eigen::Index>(mesh.number_of_faces()), 3);
-  double volume6 = 0.0;  // six times the enclosed volume: negative when the triangles face inwards
   for (auto f : mesh.faces()) {
     int k = 0;
     for (auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh))
       out.faces(static_cast<Eigen::Index>(f), k++) = static_cast<int>(v);
-    const Eigen::Vector3d a = out.vertices.row(out.faces(static_cast<Eigen::Index>(f), 0));
-    const Eigen::Vector3d b = out.vertices.row(out.faces(static_cast<Eigen::Index>(f), 1));
-    const Eigen::Vector3d c = out.vertices.row(out.faces(static_cast<Eigen::Index>(f), 2));
-    volume6 += a.dot(b.cross(c));
   }
-  if (volume6 < 0.0) out.faces.col(1).swap(out.faces.col(2));
+  // Outward triangles: a negative enclosed volume means the mesher wound them inwards.
+  if (enclosed_volume(out.vertices, out.faces) < 0.0) out.faces.col(1).swap(out.faces.col(2));
   return true;
 }
 

@@ -9,8 +9,9 @@ import { format_number } from './format.js';
 export function curve_summary_lines(report) {
   const points = Array.isArray(report.points) ? report.points : [];
   const converged = points.filter((point) => point.converged).length;
-  const unit = report.control === 'pressure' ? ' kPa' : '';
-  const what = report.control === 'pressure' ? 'pressure' : 'volume ratio';
+  const by_pressure = report.control === 'pressure';
+  const unit = by_pressure ? ' kPa' : '';
+  const what = by_pressure ? 'pressure' : 'volume ratio';
   const lines = [`${converged} of ${points.length} equilibria converged, ${what} ${format_number(report.range_from)}` +
     `${unit} to ${format_number(report.range_to)}${unit}; ${report.vertices ?? '?'} vertices; ` +
     `${report.material_name || report.material || ''}, ${format_number(report.thickness_mm, 3)} mm thick.`];
