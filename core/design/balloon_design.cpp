@@ -7,6 +7,7 @@
 #include "design/design_driver.hpp"
 #include "design/multiresolution_design.hpp"
 #include "design/reduced_space_design.hpp"
+#include "fem/thin_sheet.hpp"
 #include "mesh/mesh_geometry.hpp"
 
 namespace balloon {
@@ -47,6 +48,11 @@ std::string options_problem(const TriMesh& target, const DesignOptions& options)
     return "volume ratio must be a number above 1";
   }
   if (!(enclosed_volume(target.vertices, target.faces) > 0.0)) return "the target encloses no positive volume";
+  // The start is the target scaled down (by S, or to 1/R of its volume): that is the sheet's balloon.
+  const double start_scale = options.scale > 0 ? options.scale : std::cbrt(1.0 / options.volume_ratio);
+  if (auto problem = thin_sheet_problem(options.thickness_mm, start_scale * bounding_box_diagonal(target.vertices));
+      !problem.empty())
+    return problem;
   if (!(options.k_length >= 0.0 && options.k_bending >= 0.0 && options.k_surface >= 0.0) ||
       !std::isfinite(options.k_length + options.k_bending + options.k_surface))
     return "the objective's weights must be finite and not negative";

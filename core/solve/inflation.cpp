@@ -9,7 +9,9 @@
 #include <utility>
 
 #include "fem/balloon_model.hpp"
+#include "fem/thin_sheet.hpp"
 #include "mesh/cap_sliver_flips.hpp"
+#include "mesh/mesh_geometry.hpp"
 #include "mesh/self_intersection.hpp"
 #include "solve/equilibrium_solver.hpp"
 #include "solve/rigid_modes.hpp"
@@ -574,6 +576,10 @@ std::string options_problem(const TriMesh& rest, const InflationOptions& options
     for (double h : options.element_thickness_mm)
       if (!(h > 0.0) || !std::isfinite(h)) return "per-triangle thickness must be positive (mm)";
   }
+  const double thickest = options.element_thickness_mm.empty()
+                              ? options.thickness_mm
+                              : *std::max_element(options.element_thickness_mm.begin(), options.element_thickness_mm.end());
+  if (auto problem = thin_sheet_problem(thickest, bounding_box_diagonal(rest.vertices)); !problem.empty()) return problem;
   if (options.control == InflationControl::VolumeRatio &&
       (!(options.volume_ratio > 0.0) || !std::isfinite(options.volume_ratio)))
     return "volume ratio must be a positive number";

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "design/mold.hpp"
+#include "fem/thin_sheet.hpp"
 #include "jobs/json_writer.hpp"
 #include "mesh/mesh_geometry.hpp"
 
@@ -18,6 +19,12 @@ std::string format_number(double value) {
   char buffer[64];
   std::snprintf(buffer, sizeof(buffer), "%.6g", value);
   return buffer;
+}
+
+/// The start's size against the target's: `scale`, or the cube root of 1 / volume ratio.
+double start_scale(const DesignParameters& parameters) {
+  const double volume_ratio = parameters.volume_ratio ? *parameters.volume_ratio : DesignOptions{}.volume_ratio;
+  return parameters.scale ? *parameters.scale : std::cbrt(1.0 / volume_ratio);
 }
 
 double bbox_diagonal(const Positions& vertices) {
@@ -102,6 +109,11 @@ std::vector<FieldProblem> design_parameter_problems(const DesignParameters& para
   return problems;
 }
 
+std::string design_sheet_problem(const DesignParameters& parameters, double target_diagonal_mm) {
+  const double diagonal_mm = parameters.size_mm > 0.0 ? parameters.size_mm : target_diagonal_mm;
+  return thin_sheet_problem(parameters.thickness_mm, start_scale(parameters) * diagonal_mm);
+}
+
 Result<DesignInput> prepare_design(TriMesh target, const Material& material, const DesignParameters& parameters) {
   if (const std::vector<FieldProblem> problems = design_parameter_problems(parameters); !problems.empty())
     return fail(problems.front().message);
@@ -118,8 +130,10 @@ Result<DesignInput> prepare_design(TriMesh target, const Material& material, con
   input.material = material;
   input.parameters = parameters;
   input.method = parameters.method.empty() ? DesignOptions{}.method : *parse_design_method(parameters.method);
-  const double volume_ratio = parameters.volume_ratio ? *parameters.volume_ratio : DesignOptions{}.volume_ratio;
-  input.start_scale = parameters.scale ? *parameters.scale : std::cbrt(1.0 / volume_ratio);
+  input.start_scale = start_scale(parameters);
+  if (const std::string problem = design_sheet_problem(parameters, bounding_box_diagonal(input.target.mesh.vertices));
+      !problem.empty())
+    return fail("mesh: " + problem);
   if (!parameters.nozzle.empty()) {
     Result<NozzleSelection> selection = select_nozzle(input.target.mesh, *parse_nozzle(parameters.nozzle));
     if (!selection) return fail("nozzle: " + selection.error());

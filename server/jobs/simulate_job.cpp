@@ -4,7 +4,9 @@
 #include <cstdio>
 #include <sstream>
 
+#include "fem/thin_sheet.hpp"
 #include "mesh/mesh_checks.hpp"
+#include "mesh/mesh_geometry.hpp"
 
 namespace balloon::jobs {
 namespace {
@@ -53,6 +55,9 @@ Result<SimulateInput> prepare_simulate(TriMesh rest, const Material& material,
 
   Result<MeshCheckReport> report = validate_balloon_mesh(rest);
   if (!report) return fail("mesh: " + report.error());
+  if (const std::string problem = thin_sheet_problem(parameters.thickness_mm, bounding_box_diagonal(rest.vertices));
+      !problem.empty())
+    return fail("mesh: " + problem);
 
   SimulateInput input;
   input.flipped_orientation = report->flipped;

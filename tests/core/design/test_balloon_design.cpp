@@ -10,6 +10,7 @@
 #include "design/balloon_design.hpp"
 #include "design_test_meshes.hpp"
 #include "mesh/icosphere.hpp"
+#include "mesh/mesh_geometry.hpp"
 #include "mesh/mesh_io.hpp"
 #include "solve/inflation.hpp"
 
@@ -139,6 +140,7 @@ TEST(BalloonDesign, OnlyTheTermsTheSceneNeedsAreActive) {
   // A box with flat, coplanar faces: the rest-bending term must join; a nozzle adds its own.
   Result<TriMesh> box = read_mesh(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/cube_866.off");
   ASSERT_TRUE(box) << box.error();
+  box->vertices *= 50.0 / bounding_box_diagonal(box->vertices);  // mm: the file's 2-unit cube is no thin sheet's
   options.nozzle_vertices = {0};
   options.volume_ratio = 8.0;
   const DesignResult flat = design_balloon(*box, options);

@@ -1,0 +1,17 @@
+#pragma once
+
+#include <string>
+
+namespace balloon {
+
+/// The membrane (and hinge) model is a thin sheet's: its stresses are the mid-surface's, constant through
+/// the thickness. A sheet thicker than this fraction of its balloon's bounding-box diagonal is refused
+/// rather than simulated as if thin. A sphere's box diagonal is 3.5 radii, so the limit is a radius of at
+/// least 2.9 thicknesses; issue 10's smallest balloons (10 mm, 0.5 mm) sit at half of it.
+constexpr double MAX_THICKNESS_PER_DIAGONAL = 0.1;
+
+/// Why a sheet `thickness_mm` thick on a rest shape `rest_diagonal_mm` across (bounding-box diagonal) is
+/// not a thin sheet, naming both sizes and the remedy; "" when it is one.
+std::string thin_sheet_problem(double thickness_mm, double rest_diagonal_mm);
+
+}  // namespace balloon
