@@ -27,11 +27,6 @@ double start_scale(const DesignParameters& parameters) {
   return parameters.scale ? *parameters.scale : std::cbrt(1.0 / volume_ratio);
 }
 
-double bbox_diagonal(const Positions& vertices) {
-  if (vertices.rows() == 0) return 0.0;
-  return (vertices.colwise().maxCoeff() - vertices.colwise().minCoeff()).norm();
-}
-
 /// The mold tube for `rest`: at the nozzle the design held (scaled to the rest shape), or at the lowest
 /// point when none was asked. A radius too wide for the surface around the nozzle is halved (3 tries).
 DesignOutcome& find_mold(const DesignInput& input, DesignOutcome& outcome) {
@@ -51,7 +46,7 @@ DesignOutcome& find_mold(const DesignInput& input, DesignOutcome& outcome) {
     mold.nozzle_vertex = selection->center_vertex;
     mold.tube_radius_mm = selection->radius_mm;
   }
-  mold.tube_length_mm = MOLD_TUBE_LENGTH_FRACTION * bbox_diagonal(rest.vertices);
+  mold.tube_length_mm = MOLD_TUBE_LENGTH_FRACTION * bounding_box_diagonal(rest.vertices);
   std::string problem;
   for (int attempt = 0; attempt < 4; ++attempt, mold.tube_radius_mm *= 0.5) {
     Result<TriMesh> built = design_mold(rest, mold);
