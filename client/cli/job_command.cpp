@@ -98,6 +98,8 @@ int run_job_command(const JobCommand& command, const std::vector<std::string>& a
   if (!detach) interrupts.emplace();
   ConnectionOptions connection_options = global.connection;
   connection_options.run_jobs = !detach;  // a detached job waits in the embedded store for `jobs watch`
+  // This command's job runs now, not after jobs that killed commands left in the embedded store.
+  connection_options.run_recovered = false;
   auto connection = ServiceConnection::open(connection_options);
   if (!connection) return report_error(name, connection.error(), EXIT_UNAVAILABLE);
 

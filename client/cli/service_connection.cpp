@@ -46,6 +46,7 @@ Result<std::unique_ptr<ServiceConnection>> ServiceConnection::open(const Connect
     embedded::EmbeddedOptions embedded_options;
     embedded_options.db_path = options.db.empty() ? embedded::default_database_path() : options.db;
     embedded_options.run_jobs = options.run_jobs;
+    embedded_options.run_recovered = options.run_recovered;
     auto server = embedded::EmbeddedServer::start(embedded_options);
     if (!server && options.db.empty()) {
       // No writable data directory (a read-only home, a bare container): keep working, without history.

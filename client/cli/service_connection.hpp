@@ -24,6 +24,7 @@ struct ConnectionOptions {
   std::string tls_ca;    ///< PEM root certificate(s) for TLS to a remote server
   bool tls = false;      ///< TLS with the system roots
   bool run_jobs = true;  ///< embedded server: start workers (commands that wait for jobs)
+  bool run_recovered = true;  ///< embedded server: also run the jobs earlier processes left unfinished
 };
 
 class ServiceConnection {

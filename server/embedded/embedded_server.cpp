@@ -39,6 +39,7 @@ Result<std::unique_ptr<EmbeddedServer>> EmbeddedServer::start(const EmbeddedOpti
   service::ServiceOptions config;
   config.db_path = options.db_path;
   config.run_jobs = options.run_jobs;
+  config.run_recovered = options.run_recovered;
   config.workers = 0;  // number of cores
   // The embedded server serves one user on this machine: no limits beyond the defaults' sanity, no
   // tenant quotas, and the user's history is never deleted behind their back (no retention).

@@ -16,6 +16,9 @@ namespace balloon::embedded {
 struct EmbeddedOptions {
   std::string db_path;   ///< SQLite file (its folder is created); ":memory:" for a throw-away store
   bool run_jobs = true;  ///< false: store and queue jobs but start no workers (commands that do not wait)
+  /// false: jobs an earlier process left unfinished stay queued and are not run here, so a command's own
+  /// job does not wait behind them (a command killed mid-job leaves its job running in the store)
+  bool run_recovered = true;
 };
 
 /// One user's service on this machine: no tenant quotas and no retention (their history is never deleted

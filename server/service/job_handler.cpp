@@ -131,9 +131,12 @@ int JobHandler::start() {
   if (m_options.recover && sole_user) {
     const store::JobStore::Recovery recovery = m_jobs.recover_unfinished(m_options.max_attempts);
     for (const store::JobRecord& job : recovery.crashed) log("job " + job.job_id + " failed: " + job.error);
-    for (const store::JobRecord& job : recovery.queued) {
-      m_queue.push_recovered(job.row_id, job.owner, job.priority);
-      ++recovered;
+    // Re-queued in the store either way (no job stays "running" with nothing running it).
+    if (m_options.run_recovered) {
+      for (const store::JobRecord& job : recovery.queued) {
+        m_queue.push_recovered(job.row_id, job.owner, job.priority);
+        ++recovered;
+      }
     }
     if (recovered > 0) log("recovered " + std::to_string(recovered) + " unfinished job(s) from " + m_store.path());
   } else if (!sole_user) {

@@ -15,6 +15,9 @@ struct ServiceOptions {
   int progress_mesh_every = 1;          ///< default K: every K-th shape-carrying progress event streams the mesh
   double checkpoint_interval_s = 0.25;  ///< at most one stored progress checkpoint per job per interval (s)
   bool recover = true;                  ///< re-queue unfinished jobs at start (only if no other process uses the store)
+  /// false: the jobs recover re-queues stay queued in the store and this process does not run them (an
+  /// embedded CLI command runs its own job only; `jobs watch` runs the rest)
+  bool run_recovered = true;
   int max_attempts = 3;                 ///< a job found running at start after this many starts FAILS; 0 no limit
   int max_queued_per_tenant = 100;      ///< queued jobs per tenant; more get RESOURCE_EXHAUSTED; 0 no limit
   int max_running_per_tenant = 4;       ///< jobs of one tenant running at once (others wait their turn); 0 no limit

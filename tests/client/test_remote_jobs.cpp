@@ -302,6 +302,29 @@ TEST_F(RemoteJobs, CtrlCOnTheEmbeddedServerLeavesTheJobInTheStoreAndJobsWatchRun
   EXPECT_EQ(json_number_field(after.out, "attempts"), 2.0) << after.out;
 }
 
+TEST_F(RemoteJobs, AJobAKilledCommandLeftInTheEmbeddedStoreDoesNotHoldUpTheNextCommand) {
+  const std::string db = s_scratch->file("killed.db");
+  auto killed = start_balloon(*s_scratch, {"design", s_scratch->file("bumpy4.obj"), "--material", "silicone",
+                                           "--resolution", "0", "--max-time", "60", "--db", db, "--out-dir",
+                                           s_scratch->file("killed-out")});
+  ASSERT_TRUE(killed->wait_for_stderr(" s] ", 60.0)) << killed->so_far().err;
+  const std::string id = job_id_in(killed->so_far().err);
+  ASSERT_FALSE(id.empty()) << killed->so_far().err;
+  killed->send_signal(SIGKILL);  // no chance to put its job back: the store still says running
+  killed->wait();
+
+  // The next command runs its own job and not the design (two such designs took both workers, and the
+  // command's job waited behind them); the design is put back in the queue, not left "running" with
+  // nothing running it, for `jobs watch` to run.
+  const std::string sphere = s_scratch->file("killed-sphere.obj");
+  ASSERT_EQ(run({"mesh", "sphere", "--radius", "10", "--subdivisions", "1", "--out", sphere}).exit_code, 0);
+  const ProcessResult simulated = run({"simulate", sphere, "--material", "latex", "--volume-ratio", "2", "--db", db});
+  EXPECT_EQ(simulated.exit_code, 0) << simulated.err;
+  const ProcessResult shown = run({"jobs", "show", id, "--db", db, "--json"});
+  EXPECT_EQ(json_field(shown.out, "state"), "\"JOB_STATE_QUEUED\"") << shown.out;
+  EXPECT_EQ(json_number_field(shown.out, "attempts"), 1.0) << shown.out;
+}
+
 // Issue 12's must-show: a design on a server killed with kill -9 continues, after the restart, from its
 // stored checkpoint (the iteration count keeps rising from where it was), finishes, and `jobs result`
 // writes the five files.
