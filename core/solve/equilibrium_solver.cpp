@@ -212,6 +212,7 @@ NewtonReport EquilibriumSolver::solve_pressure(Eigen::VectorXd& x, double pressu
       report.message = "Newton iteration limit reached";
       return report;
     }
+    if (settings.on_iteration) settings.on_iteration(report.iterations, report.residual_norm, pressure_mpa);
     if (should_stop(settings, report)) return report;
     if (!factorize_stiffness(x, pressure_mpa)) {
       report.stop = NewtonStop::NotFactorizable;
@@ -288,6 +289,7 @@ NewtonReport EquilibriumSolver::newton_volume(Eigen::VectorXd& x, double& pressu
       report.message = "Newton iteration limit reached";
       return report;
     }
+    if (settings.on_iteration) settings.on_iteration(report.iterations, report.residual_norm, pressure_mpa);
     if (should_stop(settings, report)) return report;
     if (settings.abandon_slow) {
       scaled_residuals.push_back(report.residual_norm / force_tolerance);

@@ -1,9 +1,11 @@
 #pragma once
+
 /// Newton's method for the static equilibrium of a pressurised membrane, under pressure control
 /// (minimise W(x) - p V(x)) or volume control (V(x) = V_target with p as the Lagrange multiplier,
 /// which passes pressure maxima). A stateful object: the sparsity pattern and CHOLMOD's symbolic
 /// analysis are built once and reused by every Newton step, load step and design iteration.
 #include <Eigen/Core>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -89,6 +91,9 @@ struct NewtonSettings {
   /// design's trials start a first-order step from their solution, so a trial that converges this slowly
   /// has stepped into a wrinkling or snapping region, and a shorter step costs less than finishing it.
   bool abandon_slow = false;
+  /// Called at every Newton iteration that goes on (not at the converged one) with the iteration's index
+  /// within this solve, its residual norm (N) and pressure (MPa): the progress of a long solve.
+  std::function<void(int iteration, double residual_norm, double pressure_mpa)> on_iteration;
 };
 
 class EquilibriumSolver {

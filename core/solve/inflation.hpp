@@ -51,6 +51,10 @@ struct InflationOptions {
   /// NewtonSettings::shift_after_cut_short for this path; the design's start passes its own (off).
   bool sqp_shift_after_cut_short = true;
   ProgressCallback progress;                 ///< optional
+  /// Seconds between the "newton" progress events within a step (each Newton iteration's residual and
+  /// pressure, no shape), so a long step shows it is alive; the first comes after as long. "inflate"
+  /// events come once per volume or pressure step reached, with the shape.
+  double newton_progress_interval_s = 1.0;
   const CancelToken* cancel = nullptr;       ///< optional
 };
 

@@ -337,6 +337,48 @@ TEST(Inflation, FlatFacedBoxInflatesFromZeroPressure) {
   EXPECT_LT(result.volume_ratio, 1.01);
 }
 
+TEST(Inflation, ALongStepReportsItsNewtonIterationsAsItGoes) {
+  // The cube to x8: several volume steps of several Newton iterations each. With no interval, every
+  // iteration that goes on is one "newton" event (its index counted over the run), and every step
+  // reached one "inflate" event with the shape.
+  auto mesh = read_mesh(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/cube_866.off");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  mesh->vertices *= 100.0 / bounding_box_diagonal(mesh->vertices);
+  InflationOptions options;
+  options.material = *parse_material_spec("silicone");
+  options.volume_ratio = 8.0;
+  options.newton_progress_interval_s = 0.0;
+  int newton_events = 0, inflate_events = 0, last_iteration = -1;
+  bool ordered = true, finite = true, shapes_only_when_reached = true;
+  options.progress = [&](const ProgressEvent& event) {
+    if (event.phase == "newton") {
+      ++newton_events;
+      ordered = ordered && event.iteration > last_iteration;
+      last_iteration = event.iteration;
+      finite = finite && std::isfinite(event.residual_norm) && std::isfinite(event.pressure_kpa);
+      shapes_only_when_reached = shapes_only_when_reached && event.shape == nullptr;
+    } else if (event.phase == "inflate") {
+      ++inflate_events;
+      shapes_only_when_reached = shapes_only_when_reached && event.shape != nullptr;
+    }
+  };
+  const InflationResult result = inflate(*mesh, options);
+  ASSERT_TRUE(result.converged) << result.message;
+  EXPECT_EQ(newton_events, result.newton_iterations);
+  EXPECT_EQ(last_iteration, result.newton_iterations - 1);
+  EXPECT_EQ(inflate_events, result.load_steps);
+  EXPECT_TRUE(ordered);
+  EXPECT_TRUE(finite);
+  EXPECT_TRUE(shapes_only_when_reached);
+
+  // The default interval (1 s) lets far fewer through on this fast case.
+  options.newton_progress_interval_s = InflationOptions().newton_progress_interval_s;
+  newton_events = 0;
+  last_iteration = -1;
+  inflate(*mesh, options);
+  EXPECT_LT(newton_events, result.newton_iterations);
+}
+
 TEST(Inflation, TensionFieldChangesNothingOnATautSphere) {
   // A sphere is in equibiaxial tension everywhere: no triangle is relaxed and the law holds as before.
   const TriMesh sphere = make_icosphere(10.0, 2);
