@@ -25,6 +25,11 @@ constexpr double MPA_PER_KPA = 1e-3;
 constexpr int MAX_RESUMES = 4;
 /// Newton steps of one attempt at a volume step.
 constexpr int ATTEMPT_NEWTON_STEPS = 60;
+/// Pressure control past a pressure maximum below the target follows the volume path this far (V / V_rest,
+/// issue 14's widest curve) for the pressure to climb back before it calls the target above the maximum.
+constexpr double MAX_VOLUME_RATIO_PAST_A_PEAK = 250.0;
+/// Volume-controlled solves that close the bracket around a target pressure at most (settle_at_pressure).
+constexpr int MAX_BRACKET_STEPS = 40;
 /// Newton steps of an attempt after which, while the early bent try is still unused, a membrane that
 /// creeps through wrinkles tries bending (see attempt_volume_step()).
 constexpr int CREEP_CHECK_STEPS = 20;
@@ -490,12 +495,21 @@ class InflationRun {
     }
     const double rest_volume = m_model.volume(flat_rest());
     double step = 0.5 * rest_volume;
-    double peak_pressure = state.pressure;
+    // The highest pressure on the path so far, and where; past a maximum below the target the path goes
+    // on, for the pressure may climb again (a lobe that popped, a stiffening rubber's third branch).
+    PathPoint peak = state;
+    bool past_peak = false;
     NewtonReport report;
     while (state.pressure < target_pressure) {
       PathPoint previous = state;
       if (!volume_step(state, state.volume + step, report)) {
-        if (report.stop != NewtonStop::Cancelled && stopped_passing_through_itself(state, message)) return false;
+        if (report.stop != NewtonStop::Cancelled && stopped_passing_through_itself(state, message)) {
+          if (past_peak)
+            message += "; before that the pressure fell after a maximum of " + format_kpa(peak.pressure) +
+                       " at volume ratio " + format_number(peak.volume / rest_volume) + ", below the " +
+                       format_kpa(target_pressure) + " asked for";
+          return false;
+        }
         if (stopped(report)) {
           message = report.message;
           return false;
@@ -503,43 +517,89 @@ class InflationRun {
         if (creeping_through_wrinkles(report) && switch_bending_on()) continue;
         step *= 0.5;
         if (step < 1e-5 * rest_volume) {
+          // Past a peak, a path that ends leaves the peak the highest pressure this balloon holds.
+          if (past_peak) return above_maximum_pressure(state, peak, target_pressure, message);
           message = "no equilibrium found on the way to " + format_kpa(target_pressure) + " (" + report.message + ")";
           return false;
         }
         continue;
       }
-      peak_pressure = std::max(peak_pressure, state.pressure);
-      if (state.pressure < previous.pressure && previous.pressure < target_pressure) {
-        m_stop = InflationStop::AboveMaximumPressure;
-        message = "no equilibrium: " + format_kpa(target_pressure) + " exceeds the balloon's maximum pressure of about " +
-                  format_kpa(peak_pressure) + " (use volume control to pass it)";
-        return false;
-      }
-      if (state.volume > 1e6 * rest_volume) {
+      if (state.pressure > peak.pressure) peak = state;
+      past_peak = past_peak || state.pressure < previous.pressure;
+      if (state.pressure < target_pressure && past_peak && state.volume > MAX_VOLUME_RATIO_PAST_A_PEAK * rest_volume)
+        return above_maximum_pressure(state, peak, target_pressure, message);
+      if (state.pressure < target_pressure && state.volume > 1e6 * rest_volume) {
         message = "no equilibrium below volume ratio 1e6 for " + format_kpa(target_pressure);
         return false;
       }
       if (state.pressure >= target_pressure) {
-        // Bracketed: interpolate between the two path points, then solve at the exact pressure.
-        const double theta = (target_pressure - previous.pressure) / (state.pressure - previous.pressure);
-        Eigen::VectorXd x = previous.x + theta * (state.x - previous.x);
-        report = m_solver.solve_pressure(x, target_pressure, m_settings);
-        m_newton_iterations += report.iterations;
-        if (!report.converged) {
-          message = "no equilibrium found at " + format_kpa(target_pressure) + " (" + report.message + ", residual " +
-                    format_number(report.residual_norm) + " N)";
-          state.x = x;
-          state.pressure = target_pressure;
-          state.volume = m_model.volume(x);
-          return false;
-        }
-        state = {x, target_pressure, m_model.volume(x)};
-        m_final_message = report.message;
+        if (!settle_at_pressure(state, previous, state, target_pressure, message)) return false;
+        if (past_peak)
+          m_final_message += "; on the way the pressure fell after a maximum of " + format_kpa(peak.pressure) +
+                             " at volume ratio " + format_number(peak.volume / rest_volume) +
+                             ": at that pressure the balloon snaps to a larger shape, and this is the one it reaches";
         return true;
       }
       if (report.iterations <= 6) step *= 2.0;
     }
     return true;
+  }
+
+  /// Pressure control asked for more than the path's highest pressure: the state goes back to that peak.
+  bool above_maximum_pressure(PathPoint& state, const PathPoint& peak, double target_pressure, std::string& message) {
+    m_stop = InflationStop::AboveMaximumPressure;
+    message = "no equilibrium: " + format_kpa(target_pressure) + " exceeds the balloon's maximum pressure of about " +
+              format_kpa(peak.pressure) + " (the highest on its volume path up to volume ratio " +
+              format_number(state.volume / m_rest_volume) + "; use volume control to pass it)";
+    state = peak;
+    return false;
+  }
+
+  /// The equilibrium at `target_pressure` between two volume-path points whose pressures bracket it: a
+  /// root of p(V) = target by regula falsi (Illinois) over volume-controlled solves, each started from
+  /// the bracket's interpolation. A volume-controlled equilibrium whose multiplier is the target pressure
+  /// is the pressure-controlled one, so the test is the pressure solve's own (|grad W - p grad V| within
+  /// the tolerance). A Newton solve at fixed pressure from the interpolation crept instead where the
+  /// bracket spans wrinkles (the knot: 128 Newton steps, then the iteration limit).
+  /// `state` becomes that equilibrium, or on failure the bracket's end closer to it.
+  bool settle_at_pressure(PathPoint& state, PathPoint low, PathPoint high, double target_pressure, std::string& message) {
+    double low_excess = low.pressure - target_pressure, high_excess = high.pressure - target_pressure;
+    int kept_side = 0;  // Illinois: the side kept twice running has its excess halved
+    NewtonReport report;
+    for (int bracket_step = 0; bracket_step < MAX_BRACKET_STEPS; ++bracket_step) {
+      PathPoint& closer = -low_excess < high_excess ? low : high;
+      if (m_solver.residual(closer.x, target_pressure).norm() <=
+          m_settings.relative_tolerance * m_solver.force_scale(closer.x, target_pressure)) {
+        state = {closer.x, target_pressure, closer.volume};
+        m_final_message = "converged";
+        return true;
+      }
+      const double theta = std::clamp(-low_excess / (high_excess - low_excess), 0.0, 1.0);
+      PathPoint guess{low.x + theta * (high.x - low.x), target_pressure, low.volume + theta * (high.volume - low.volume)};
+      PathPoint reached = low;
+      if (!volume_step(reached, guess.volume, report, &guess)) {
+        message = "no equilibrium found at " + format_kpa(target_pressure) + " (" + report.message + ", residual " +
+                  format_number(report.residual_norm) + " N)";
+        state = closer;
+        return false;
+      }
+      const double excess = reached.pressure - target_pressure;
+      if (excess < 0.0) {
+        low = reached;
+        low_excess = excess;
+        if (kept_side == 1) high_excess *= 0.5;
+        kept_side = 1;
+      } else {
+        high = reached;
+        high_excess = excess;
+        if (kept_side == -1) low_excess *= 0.5;
+        kept_side = -1;
+      }
+    }
+    message = "no equilibrium found at " + format_kpa(target_pressure) + " (the bracket did not close in " +
+              std::to_string(MAX_BRACKET_STEPS) + " volume steps)";
+    state = -low_excess < high_excess ? low : high;
+    return false;
   }
 
   void fill(InflationResult& result, const PathPoint& state) {

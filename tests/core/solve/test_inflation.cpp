@@ -131,6 +131,54 @@ TEST(Inflation, PressureAboveTheMaximumIsReportedNotCrashed) {
   EXPECT_TRUE(result.deformed.allFinite());
 }
 
+TEST(Inflation, PressureAboveAMaximumThatTheStiffeningRubberClimbsBackToSnapsToTheFarBranch) {
+  // A Mooney-Rivlin sphere's pressure rises to a maximum, falls, and climbs again as the C2 term
+  // stiffens it: above the maximum the balloon snaps to the far branch, where p matches the closed form.
+  const TriMesh sphere = make_icosphere(10.0, 3);
+  // C2 / C1 = 1/6: the maximum at a stretch of 1.58, the minimum at 2.37 (3% lower), 1.05 times the
+  // maximum again at 3.64.
+  const Material rubber = make(MaterialModel::MooneyRivlin, 0.18, 0.03);
+  const double radius = 3.0 * mesh_volume(sphere) / mesh_area(sphere);
+  double peak = 0.0, peak_stretch = 1.0;
+  for (double l = 1.01; l < 2.0; l += 0.001) {
+    if (sphere_pressure_kpa(rubber, 0.5, radius, l) > peak) {
+      peak = sphere_pressure_kpa(rubber, 0.5, radius, l);
+      peak_stretch = l;
+    }
+  }
+  InflationOptions options;
+  options.material = rubber;
+  options.control = InflationControl::Pressure;
+  options.pressure_kpa = 1.05 * peak;
+  const InflationResult result = inflate(sphere, options);
+  ASSERT_TRUE(result.converged) << result.message;
+  EXPECT_NEAR(result.pressure_kpa, 1.05 * peak, 1e-9 * peak);
+  EXPECT_NE(result.message.find("snaps"), std::string::npos) << result.message;
+  const double stretch = std::cbrt(result.volume_ratio);
+  EXPECT_GT(stretch, 2.0 * peak_stretch);  // past the maximum and the minimum after it
+  EXPECT_NEAR(sphere_pressure_kpa(rubber, 0.5, radius, stretch), 1.05 * peak, 5e-3 * peak);
+}
+
+TEST(Inflation, PressureControlSettlesOnAShapeThatWrinklesBetweenTwoVolumeSteps) {
+  // The knot's tube under a pressure its volume path reaches at x2: a Newton solve at that fixed pressure,
+  // started between the two path points that bracket it, crept to its iteration limit (128 steps, "no
+  // equilibrium found"); the bracket is now closed by volume-controlled solves.
+  const InflationResult by_volume = inflate_corpus_mesh("knot.off", 200.0, "latex", 2.0);
+  ASSERT_TRUE(by_volume.converged) << by_volume.message;
+  auto mesh = read_mesh(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/knot.off");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  mesh->vertices *= 200.0 / bounding_box_diagonal(mesh->vertices);
+  InflationOptions options;
+  options.material = *parse_material_spec("latex");
+  options.control = InflationControl::Pressure;
+  options.pressure_kpa = 0.9 * by_volume.pressure_kpa;
+  const InflationResult result = inflate(*mesh, options);
+  ASSERT_TRUE(result.converged) << result.message;
+  EXPECT_NEAR(result.pressure_kpa, options.pressure_kpa, 1e-12 * options.pressure_kpa);
+  EXPECT_GT(result.volume_ratio, 1.0);
+  EXPECT_LT(result.volume_ratio, 2.0);
+}
+
 TEST(Inflation, BadOptionsAreReportedNotThrown) {
   const TriMesh sphere = make_icosphere(10.0, 1);
   InflationOptions options;
