@@ -139,7 +139,7 @@ PressureVolumeCurve trace_pressure_volume_curve(const TriMesh& rest, const Press
       continue;
     }
     point.converged = true;
-    point.message = "converged";
+    point.message = result.message;  // "converged", or with what it passed (a snap under pressure control)
     point.volume_ratio = result.volume_ratio;
     point.pressure_kpa = result.pressure_kpa;
     point.mean_stretch = result.mean_stretch;
