@@ -8,9 +8,12 @@
 // (an equilibrium that passes through itself is such an answer: counted apart, not as a failure). --tension-field
 // switches on Pipkin's relaxation (InflationOptions::tension_field, off by default).
 // --bending on|off|auto sets InflationOptions::bending (auto by default: switched on when a volume step fails).
+// --pressure-fraction F runs each case under pressure control instead, at F times the pressure its volume
+// run reaches (that run first, untimed; a case without one is skipped): an answer above the balloon's
+// maximum pressure is physical too ("max", counted apart).
 // Usage: bench_robustness [DATA_DIR] [--mesh SUBSTRING]... [--material silicone|latex|neo-hookean]
 //                         [--resolution N=4000] [--max-time S=120] [--tension-field] [--bending on|off|auto]
-//                         [--quick]
+//                         [--pressure-fraction F] [--quick]
 //   --quick: 200 mm as given, the largest ratio only (one case per mesh and material).
 #include <algorithm>
 #include <chrono>
@@ -69,6 +72,7 @@ int main(int argc, char** argv) {
   double max_time_s = 120.0;
   bool quick = false;
   bool tension_field = false;
+  double pressure_fraction = 0.0;  // > 0: each case under pressure control at this fraction of its volume run's pressure
   balloon::BendingUse bending = balloon::BendingUse::Auto;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -89,6 +93,7 @@ int main(int argc, char** argv) {
     else if (arg == "--material") material_filters.push_back(value());
     else if (arg == "--resolution") resolution = std::atoi(value().c_str());
     else if (arg == "--max-time") max_time_s = std::atof(value().c_str());
+    else if (arg == "--pressure-fraction") pressure_fraction = std::atof(value().c_str());
     else if (!arg.empty() && arg[0] == '-') {
       std::fprintf(stderr, "unknown option %s\n", arg.c_str());
       return 2;
@@ -109,12 +114,19 @@ int main(int argc, char** argv) {
   const std::vector<double> sizes = quick ? std::vector<double>{200.0} : std::vector<double>{20.0, 200.0};
   const std::vector<double> shrink_factors = quick ? std::vector<double>{1.0} : std::vector<double>{1.0, 0.5};
 
-  std::printf("volume-controlled inflation, thickness 0.5 mm, remesh above %d vertices to %d, %g s per case\n",
-              resolution * 5 / 4, resolution, max_time_s);
+  if (pressure_fraction > 0.0)
+    std::printf("pressure-controlled inflation at %g times the pressure the volume path reaches at each ratio "
+                "(that run not timed or counted), ",
+                pressure_fraction);
+  else
+    std::printf("volume-controlled inflation, ");
+  std::printf("thickness 0.5 mm, remesh above %d vertices to %d, %g s per case\n", resolution * 5 / 4, resolution,
+              max_time_s);
   std::printf("%-26s %6s %5s %6s %-12s %5s %-5s %4s %7s %7s %8s %8s %10s  %s\n", "mesh", "verts", "size", "form",
               "material", "ratio", "conv", "bend", "newton", "factors", "time_s", "peak_MB", "MB/1k_vert", "message");
   std::vector<Failure> failures;
   int passes_through_itself = 0;  // converged, but the surface intersects itself: "self" in the table
+  int above_maximum = 0;          // pressure control above the balloon's maximum pressure: "max"
   std::vector<double> times;
   int cases = 0;
   for (const std::string& file : files) {
@@ -160,20 +172,31 @@ int main(int argc, char** argv) {
             options.max_time_s = max_time_s;
             options.tension_field = tension_field;
             options.bending = bending;
+            if (pressure_fraction > 0.0) {
+              // The reference: the pressure the volume path reaches at this ratio, which the pressure run's
+              // path passes below it (a case whose volume run has no answer has no pressure case).
+              const balloon::InflationResult reference = balloon::inflate(rest, options);
+              if (!reference.converged) continue;
+              options.control = balloon::InflationControl::Pressure;
+              options.pressure_kpa = pressure_fraction * reference.pressure_kpa;
+            }
             balloon::bench::reset_peak_memory();
             const balloon::InflationResult result = balloon::inflate(rest, options);
             const double peak_mb = balloon::bench::peak_memory_mb();
             ++cases;
             times.push_back(result.time_s);
             const char* form = shrink == 1.0 ? "given" : "half";
-            const bool physical_answer = result.stop == balloon::InflationStop::PassesThroughItself;
+            const bool self = result.stop == balloon::InflationStop::PassesThroughItself;
+            const bool above = result.stop == balloon::InflationStop::AboveMaximumPressure;
+            const bool physical_answer = self || above;
             std::printf("%-26s %6d %5.0f %6s %-12s %5.0f %-5s %4s %7d %7d %8.2f %8.1f %10.2f  %s\n", file.c_str(),
                         rest.vertex_count(), size, form, m.label.c_str(), ratio,
-                        result.converged ? "yes" : physical_answer ? "self" : "NO", result.bending ? "on" : "off",
+                        result.converged ? "yes" : self ? "self" : above ? "max" : "NO", result.bending ? "on" : "off",
                         result.newton_iterations, result.factorizations, result.time_s, peak_mb,
                         1000.0 * peak_mb / rest.vertex_count(), result.converged ? "" : result.message.c_str());
             std::fflush(stdout);
-            if (physical_answer) ++passes_through_itself;
+            if (self) ++passes_through_itself;
+            if (above) ++above_maximum;
             if (!result.converged && !physical_answer) {
               char label[256];
               std::snprintf(label, sizeof(label), "%s %g mm %s %s x%g", file.c_str(), size, form, m.label.c_str(),
@@ -186,8 +209,9 @@ int main(int argc, char** argv) {
     }
   }
   const double max_time = times.empty() ? 0.0 : *std::max_element(times.begin(), times.end());
-  std::printf("\ncases %d, failures %zu, passes through itself %d, time per case median %.2f s, max %.2f s\n",
-              cases, failures.size(), passes_through_itself, median(times), max_time);
+  std::printf("\ncases %d, failures %zu, passes through itself %d, ", cases, failures.size(), passes_through_itself);
+  if (pressure_fraction > 0.0) std::printf("above the maximum pressure %d, ", above_maximum);
+  std::printf("time per case median %.2f s, max %.2f s\n", median(times), max_time);
   for (const Failure& f : failures) std::printf("FAILED %s: %s\n", f.label.c_str(), f.message.c_str());
   return failures.empty() ? 0 : 1;
 }
