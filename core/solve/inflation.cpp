@@ -576,8 +576,25 @@ class InflationRun {
       }
       const double theta = std::clamp(-low_excess / (high_excess - low_excess), 0.0, 1.0);
       PathPoint guess{low.x + theta * (high.x - low.x), target_pressure, low.volume + theta * (high.volume - low.volume)};
+      // From the interpolation, else as the path steps: from the lower end's equilibrium, scaled.
       PathPoint reached = low;
-      if (!volume_step(reached, guess.volume, report, &guess)) {
+      if (!volume_step(reached, guess.volume, report, &guess) && !stopped(report) &&
+          !volume_step(reached, guess.volume, report)) {
+        if (stopped(report)) {
+          message = report.message;
+          state = closer;
+          return false;
+        }
+        // Last, Newton at the target pressure from the closer end (the spool with latex, whose pressure
+        // triples between two path points, failed its volume solves in between).
+        Eigen::VectorXd x = closer.x;
+        const NewtonReport at_pressure = m_solver.solve_pressure(x, target_pressure, m_settings);
+        m_newton_iterations += at_pressure.iterations;
+        if (at_pressure.converged) {
+          state = {x, target_pressure, m_model.volume(x)};
+          m_final_message = at_pressure.message;
+          return true;
+        }
         message = "no equilibrium found at " + format_kpa(target_pressure) + " (" + report.message + ", residual " +
                   format_number(report.residual_norm) + " N)";
         state = closer;
