@@ -585,20 +585,9 @@ class InflationRun {
           state = closer;
           return false;
         }
-        // Last, Newton at the target pressure from the closer end (the spool with latex, whose pressure
-        // triples between two path points, failed its volume solves in between).
-        Eigen::VectorXd x = closer.x;
-        const NewtonReport at_pressure = m_solver.solve_pressure(x, target_pressure, m_settings);
-        m_newton_iterations += at_pressure.iterations;
-        if (at_pressure.converged) {
-          state = {x, target_pressure, m_model.volume(x)};
-          m_final_message = at_pressure.message;
-          return true;
-        }
-        message = "no equilibrium found at " + format_kpa(target_pressure) + " (" + report.message + ", residual " +
-                  format_number(report.residual_norm) + " N)";
-        state = closer;
-        return false;
+        // The spool with latex, whose pressure triples between two path points, failed its volume solves
+        // in between.
+        return settle_by_pressure_newton(state, closer, target_pressure, report, message);
       }
       const double excess = reached.pressure - target_pressure;
       if (excess < 0.0) {
@@ -613,9 +602,32 @@ class InflationRun {
         kept_side = -1;
       }
     }
-    message = "no equilibrium found at " + format_kpa(target_pressure) + " (the bracket did not close in " +
-              std::to_string(MAX_BRACKET_STEPS) + " volume steps)";
-    state = -low_excess < high_excess ? low : high;
+    // The volume solves in between landed on other branches (the rotor at half size with latex: p(V) jumps).
+    report.message = "the bracket did not close in " + std::to_string(MAX_BRACKET_STEPS) + " volume steps";
+    report.residual_norm = 0.0;  // each of those converged
+    return settle_by_pressure_newton(state, -low_excess < high_excess ? low : high, target_pressure, report, message);
+  }
+
+  /// settle_at_pressure's last resort: Newton at the target pressure from the bracket's closer end.
+  /// `failed` is why the bracket could not be closed, for the message when this fails too.
+  bool settle_by_pressure_newton(PathPoint& state, const PathPoint& closer, double target_pressure,
+                                 const NewtonReport& failed, std::string& message) {
+    Eigen::VectorXd x = closer.x;
+    const NewtonReport at_pressure = m_solver.solve_pressure(x, target_pressure, m_settings);
+    m_newton_iterations += at_pressure.iterations;
+    if (at_pressure.converged) {
+      state = {x, target_pressure, m_model.volume(x)};
+      m_final_message = at_pressure.message;
+      return true;
+    }
+    if (stopped(at_pressure)) {
+      message = at_pressure.message;
+    } else {
+      message = "no equilibrium found at " + format_kpa(target_pressure) + " (" + failed.message +
+                (failed.residual_norm > 0.0 ? ", residual " + format_number(failed.residual_norm) + " N" : "") +
+                "; then at that pressure: " + at_pressure.message + ")";
+    }
+    state = closer;
     return false;
   }
 
