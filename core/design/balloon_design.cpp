@@ -49,8 +49,8 @@ std::string options_problem(const TriMesh& target, const DesignOptions& options)
   }
   if (!(enclosed_volume(target.vertices, target.faces) > 0.0)) return "the target encloses no positive volume";
   // The start is the target scaled down (by S, or to 1/R of its volume): that is the sheet's balloon.
-  const double start_scale = options.scale > 0 ? options.scale : std::cbrt(1.0 / options.volume_ratio);
-  if (auto problem = thin_sheet_problem(options.thickness_mm, start_scale * bounding_box_diagonal(target.vertices));
+  if (auto problem =
+          thin_sheet_problem(options.thickness_mm, design_start_scale(options) * bounding_box_diagonal(target.vertices));
       !problem.empty())
     return problem;
   if (!(options.k_length >= 0.0 && options.k_bending >= 0.0 && options.k_surface >= 0.0) ||
@@ -68,6 +68,10 @@ std::string options_problem(const TriMesh& target, const DesignOptions& options)
 }
 
 }  // namespace
+
+double design_start_scale(const DesignOptions& options) {
+  return options.scale > 0 ? options.scale : std::cbrt(1.0 / options.volume_ratio);
+}
 
 /// The entry point: refuse what cannot be designed, then set up the run and hand it to the chosen
 /// optimizer (reduced_space_design.hpp, augmented_lagrangian_design.hpp).

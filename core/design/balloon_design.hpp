@@ -136,4 +136,8 @@ struct DesignResult {
 /// Designs the rest shape for `target`. Never throws for bad numerics: failures are in the result.
 DesignResult design_balloon(const TriMesh& target, const DesignOptions& options);
 
+/// The start's size against the target's (a ratio of lengths): `options.scale` when set, else the cube
+/// root of 1 / `options.volume_ratio`.
+double design_start_scale(const DesignOptions& options);
+
 }  // namespace balloon

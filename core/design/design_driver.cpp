@@ -36,7 +36,7 @@ std::vector<bool> rigid_support(const TriMesh& mesh) {
 
 TriMesh design_start_shape(const TriMesh& target, const DesignOptions& options) {
   TriMesh start = target;
-  const double scale = options.scale > 0 ? options.scale : std::cbrt(1.0 / options.volume_ratio);
+  const double scale = design_start_scale(options);
   if (options.initial_rest.rows() == 0) {
     start.vertices = scaled_about_centroid(target.vertices, scale);
     return start;

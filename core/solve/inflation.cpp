@@ -505,9 +505,7 @@ class InflationRun {
       if (!volume_step(state, state.volume + step, report)) {
         if (report.stop != NewtonStop::Cancelled && stopped_passing_through_itself(state, message)) {
           if (past_peak)
-            message += "; before that the pressure fell after a maximum of " + format_kpa(peak.pressure) +
-                       " at volume ratio " + format_number(peak.volume / rest_volume) + ", below the " +
-                       format_kpa(target_pressure) + " asked for";
+            message += "; before that " + fall_after(peak) + ", below the " + format_kpa(target_pressure) + " asked for";
           return false;
         }
         if (stopped(report)) {
@@ -535,14 +533,19 @@ class InflationRun {
       if (state.pressure >= target_pressure) {
         if (!settle_at_pressure(state, previous, state, target_pressure, message)) return false;
         if (past_peak)
-          m_final_message += "; on the way the pressure fell after a maximum of " + format_kpa(peak.pressure) +
-                             " at volume ratio " + format_number(peak.volume / rest_volume) +
+          m_final_message += "; on the way " + fall_after(peak) +
                              ": at that pressure the balloon snaps to a larger shape, and this is the one it reaches";
         return true;
       }
       if (report.iterations <= 6) step *= 2.0;
     }
     return true;
+  }
+
+  /// "the pressure fell after a maximum of P at volume ratio R", for messages about a passed `peak`.
+  std::string fall_after(const PathPoint& peak) const {
+    return "the pressure fell after a maximum of " + format_kpa(peak.pressure) + " at volume ratio " +
+           format_number(peak.volume / m_rest_volume);
   }
 
   /// Pressure control asked for more than the path's highest pressure: the state goes back to that peak.

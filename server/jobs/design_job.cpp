@@ -21,10 +21,12 @@ std::string format_number(double value) {
   return buffer;
 }
 
-/// The start's size against the target's: `scale`, or the cube root of 1 / volume ratio.
+/// The start's size against the target's (design_start_scale), absent values at DesignOptions' defaults.
 double start_scale(const DesignParameters& parameters) {
-  const double volume_ratio = parameters.volume_ratio ? *parameters.volume_ratio : DesignOptions{}.volume_ratio;
-  return parameters.scale ? *parameters.scale : std::cbrt(1.0 / volume_ratio);
+  DesignOptions options;
+  if (parameters.scale) options.scale = *parameters.scale;
+  if (parameters.volume_ratio) options.volume_ratio = *parameters.volume_ratio;
+  return design_start_scale(options);
 }
 
 /// The mold tube for `rest`: at the nozzle the design held (scaled to the rest shape), or at the lowest
