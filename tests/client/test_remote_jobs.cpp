@@ -77,6 +77,11 @@ class RemoteJobs : public ::testing::Test {
   }
   static ProcessResult run(const std::vector<std::string>& args) { return run_balloon(*s_scratch, args); }
   static std::string server() { return s_server->address(); }
+  /// A design of the bumpy sphere (60 s budget) on the embedded server with the store `db`.
+  static std::unique_ptr<RunningProcess> start_embedded_design(const std::string& db, const std::string& out_dir) {
+    return start_balloon(*s_scratch, {"design", s_scratch->file("bumpy4.obj"), "--material", "silicone", "--resolution",
+                                      "0", "--max-time", "60", "--db", db, "--out-dir", s_scratch->file(out_dir)});
+  }
 
   static v1::Job get_job(const std::string& job_id) {
     grpc::ClientContext context;
@@ -277,9 +282,7 @@ TEST_F(RemoteJobs, ASecondCtrlCCancels) {
 
 TEST_F(RemoteJobs, CtrlCOnTheEmbeddedServerLeavesTheJobInTheStoreAndJobsWatchRunsIt) {
   const std::string db = s_scratch->file("embedded.db");
-  auto cli = start_balloon(*s_scratch, {"design", s_scratch->file("bumpy4.obj"), "--material", "silicone",
-                                        "--resolution", "0", "--max-time", "60", "--db", db, "--out-dir",
-                                        s_scratch->file("embedded-out")});
+  auto cli = start_embedded_design(db, "embedded-out");
   ASSERT_TRUE(cli->wait_for_stderr(" s] ", 60.0)) << cli->so_far().err;
   cli->send_signal(SIGINT);
   const ProcessResult ended = cli->wait();
@@ -304,9 +307,7 @@ TEST_F(RemoteJobs, CtrlCOnTheEmbeddedServerLeavesTheJobInTheStoreAndJobsWatchRun
 
 TEST_F(RemoteJobs, AJobAKilledCommandLeftInTheEmbeddedStoreDoesNotHoldUpTheNextCommand) {
   const std::string db = s_scratch->file("killed.db");
-  auto killed = start_balloon(*s_scratch, {"design", s_scratch->file("bumpy4.obj"), "--material", "silicone",
-                                           "--resolution", "0", "--max-time", "60", "--db", db, "--out-dir",
-                                           s_scratch->file("killed-out")});
+  auto killed = start_embedded_design(db, "killed-out");
   ASSERT_TRUE(killed->wait_for_stderr(" s] ", 60.0)) << killed->so_far().err;
   const std::string id = job_id_in(killed->so_far().err);
   ASSERT_FALSE(id.empty()) << killed->so_far().err;
