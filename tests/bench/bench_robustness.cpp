@@ -1,7 +1,8 @@
 // Forward-solver robustness (issue 10, section 1): every corpus mesh in DATA_DIR/meshes, at two sizes
 // (20 mm and 200 mm bounding-box diagonal), as given and downscaled by half (shrunk by 0.5 about its
-// centroid, as a design start is), with silicone, latex and a Neo-Hookean rubber (mu = 0.3 MPa), each
-// inflated under volume control to ratio 2 and 8 (27 for latex), 0.5 mm thick. Meshes above
+// centroid, as a design start is), with silicone, latex, a Neo-Hookean rubber (mu = 0.3 MPa) and a
+// Mooney-Rivlin one (C1 = 0.1397, C2 = 0.0280 MPa), each inflated under volume control to ratio 2 and 8
+// (27 for latex), 0.5 mm thick. Meshes above
 // --resolution * 1.25 vertices are remeshed to --resolution vertices with the design's target
 // preparation (CGAL isotropic remeshing); smaller ones keep their slivers. Prints one line per case (with
 // the case's peak memory, MB and MB per 1,000 vertices) and the number of failures: a case fails when the solver neither converges nor says why in physical terms
@@ -11,7 +12,7 @@
 // --pressure-fraction F runs each case under pressure control instead, at F times the pressure its volume
 // run reaches (that run first, untimed; a case without one is skipped): an answer above the balloon's
 // maximum pressure is physical too ("max", counted apart).
-// Usage: bench_robustness [DATA_DIR] [--mesh SUBSTRING]... [--material silicone|latex|neo-hookean]
+// Usage: bench_robustness [DATA_DIR] [--mesh SUBSTRING]... [--material silicone|latex|neo-hookean|mooney-rivlin]
 //                         [--resolution N=4000] [--max-time S=120] [--tension-field] [--bending on|off|auto]
 //                         [--pressure-fraction F] [--quick]
 //   --quick: 200 mm as given, the largest ratio only (one case per mesh and material).
@@ -104,6 +105,9 @@ int main(int argc, char** argv) {
       {"silicone", *balloon::parse_material_spec("silicone"), {2.0, 8.0}},
       {"latex", *balloon::parse_material_spec("latex"), {2.0, 27.0}},
       {"neo-hookean", *balloon::parse_material_spec("neo-hookean:mu=0.3"), {2.0, 8.0}},
+      // Our Mooney-Rivlin fit to Meunier's equibiaxial silicone data (`balloon fit-material
+      // tests/data/materials/meunier2008_silicone_et.csv --test equibiaxial --model mooney-rivlin`).
+      {"mooney-rivlin", *balloon::parse_material_spec("mooney-rivlin:C1=0.139679,C2=0.0280028"), {2.0, 8.0}},
   };
   std::vector<std::string> files;
   for (const auto& entry : std::filesystem::directory_iterator(data_dir + "/meshes")) {
