@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <Eigen/Sparse>
+#include <algorithm>
 #include <random>
 #include <thread>
 #include <vector>
@@ -59,6 +61,80 @@ TEST(IndefiniteFactorization, InertiaAndSolveMatchTheDenseReference) {
     const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(60, -1.0, 2.0);
     const Eigen::VectorXd solution = factorization.solve(rhs);
     EXPECT_LT((matrix.dense * solution - rhs).norm(), 1e-12 * rhs.norm()) << negative << " negative";
+  }
+}
+
+TEST(IndefiniteFactorization, OneFactorizationServesManyMatricesAndPatternsInItsOwnWorkspace) {
+  // The factorization keeps MUMPS's workspace from one call to the next (and the factors live in it until
+  // the next call): matrices of one pattern one after another, then a larger pattern, then the first
+  // again. Near-zero diagonals force 2x2 and delayed pivots, which need more room than estimated.
+  IndefiniteFactorization factorization;
+  for (int n : {60, 240, 60}) {
+    for (int round = 0; round < 6; ++round) {
+      const int negative = (round * 5) % 11;
+      BandedMatrix matrix(n, negative, 100u * static_cast<unsigned>(n) + static_cast<unsigned>(round));
+      if (round % 2 == 1) {
+        for (int j = 0; j < n; j += 3) {
+          matrix.dense(j, j) = 1e-9;
+          matrix.values[static_cast<size_t>(matrix.column_starts[static_cast<size_t>(j) + 1] - 1)] = 1e-9;
+        }
+      }
+      if (round == 0) factorization.set_pattern(n, matrix.column_starts, matrix.row_indices);
+      ASSERT_EQ(factorization.factorize(matrix.values), IndefiniteFactorization::Status::Ok) << n << ", " << round;
+      EXPECT_EQ(factorization.negative_pivots(), matrix.negative_eigenvalues()) << n << ", " << round;
+      const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(n, -1.0, 2.0);
+      const Eigen::VectorXd solution = factorization.solve(rhs);
+      EXPECT_LT((matrix.dense * solution - rhs).norm(), 1e-9 * rhs.norm()) << n << ", " << round;
+    }
+  }
+}
+
+TEST(IndefiniteFactorization, AFactorizationBeyondWhatMallocRecyclesSolvesAgainAndAgain) {
+  // The pattern of a surface's stiffness with its bending hinges: a grid of side x side nodes, 3 unknowns
+  // each, every node coupled to its 8 neighbours. MUMPS's workspace is then beyond 32 MiB, so it is ours
+  // and kept from one factorization to the next. Diagonals of magnitude 10 against off-diagonal row sums
+  // below 7.8 (Gershgorin) fix the inertia: every fifth diagonal entry negative, then every third.
+  const int side = 110, n = 3 * side * side;
+  std::vector<int> column_starts{0}, row_indices;
+  for (int j = 0; j < n; ++j) {
+    const int node = j / 3, x = node % side, y = node / side;
+    std::vector<int> rows;
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (x + dx < 0 || x + dx >= side || y + dy < 0 || y + dy >= side) continue;
+        const int neighbour = (y + dy) * side + x + dx;
+        for (int c = 0; c < 3; ++c)
+          if (3 * neighbour + c <= j) rows.push_back(3 * neighbour + c);
+      }
+    std::sort(rows.begin(), rows.end());
+    row_indices.insert(row_indices.end(), rows.begin(), rows.end());
+    column_starts.push_back(static_cast<int>(row_indices.size()));
+  }
+  IndefiniteFactorization factorization;
+  factorization.set_pattern(n, column_starts, row_indices);
+  std::mt19937 random(7u);
+  std::uniform_real_distribution<double> uniform(-0.3, 0.3);
+  for (int every : {5, 3, 5}) {
+    std::vector<double> values(row_indices.size());
+    std::vector<Eigen::Triplet<double>> entries;
+    int negative = 0;
+    for (int j = 0; j < n; ++j) {
+      for (int k = column_starts[static_cast<size_t>(j)]; k < column_starts[static_cast<size_t>(j) + 1]; ++k) {
+        const int i = row_indices[static_cast<size_t>(k)];
+        const bool flipped = i == j && j % every == 0;
+        values[static_cast<size_t>(k)] = i == j ? (flipped ? -10.0 : 10.0) : uniform(random);
+        negative += flipped ? 1 : 0;
+        entries.emplace_back(i, j, values[static_cast<size_t>(k)]);
+      }
+    }
+    Eigen::SparseMatrix<double> upper(n, n);
+    upper.setFromTriplets(entries.begin(), entries.end());
+    ASSERT_EQ(factorization.factorize(values), IndefiniteFactorization::Status::Ok) << every;
+    EXPECT_EQ(factorization.negative_pivots(), negative) << every;
+    const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(n, -1.0, 2.0);
+    const Eigen::VectorXd solution = factorization.solve(rhs);
+    const Eigen::VectorXd product = upper.selfadjointView<Eigen::Upper>() * solution;
+    EXPECT_LT((product - rhs).norm(), 1e-10 * rhs.norm()) << every;
   }
 }
 
