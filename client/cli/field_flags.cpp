@@ -49,6 +49,7 @@ std::string flag_for_field(const std::string& field_path) {
       {"design.tolerance_samples", "--tolerance-samples"},
       {"simulate.material", "--material"},
       {"simulate.thickness_mm", "--thickness"},
+      {"simulate.size_mm", "--size"},
       {"simulate.pressure_kpa", "--pressure"},
       {"simulate.volume_ratio", "--volume-ratio"},
       {"simulate.curve.volume_ratio_range", "--volume-ratio-range"},

@@ -26,9 +26,9 @@ namespace v1 = balloon::v1;
 constexpr const char* COMMAND = "simulate";
 
 constexpr const char* HELP =
-    "Usage: balloon simulate REST_MESH --material SPEC [--thickness MM]\n"
+    "Usage: balloon simulate REST_MESH --material SPEC [--thickness MM] [--size MM]\n"
     "                        (--pressure KPA | --volume-ratio R) [--out FILE] [--json]\n"
-    "       balloon simulate REST_MESH --material SPEC [--thickness MM]\n"
+    "       balloon simulate REST_MESH --material SPEC [--thickness MM] [--size MM]\n"
     "                        (--volume-ratio-range A:B | --pressure-range A:B) --points N [--out PATH] [--json]\n\n"
     "Inflates the closed rest mesh REST_MESH (OBJ, STL, PLY, OFF, glTF/GLB; coordinates in mm) to\n"
     "static equilibrium, either under a given pressure or to a given enclosed-volume ratio. Runs as a job\n"
@@ -38,6 +38,8 @@ constexpr const char* HELP =
     "                      hart-smith:G=0.1,k1=3e-4,k2=1.0 (moduli in MPa) | preset: silicone, latex |\n"
     "                      the name of a stored material (balloon materials list)\n"
     "  --thickness MM      rest membrane thickness in mm (default 0.5)\n"
+    "  --size MM           first scale REST_MESH (about the origin) so its bounding-box diagonal is MM,\n"
+    "                      e.g. for a mesh drawn in metres or units (default: keep its size)\n"
     "  --pressure KPA      inflate under this pressure (kPa, > 0)\n"
     "  --volume-ratio R    inflate until V / V_rest = R (> 0); passes pressure maxima\n"
     "  --volume-ratio-range A:B\n"

@@ -14,7 +14,7 @@
 namespace balloon::cli {
 
 std::vector<OptionSpec> simulate_option_specs() {
-  return {{"material"}, {"thickness"}, {"pressure"}, {"volume-ratio"}, {"volume-ratio-range"}, {"pressure-range"}, {"points"}};
+  return {{"material"}, {"thickness"}, {"size"}, {"pressure"}, {"volume-ratio"}, {"volume-ratio-range"}, {"pressure-range"}, {"points"}};
 }
 
 namespace {
@@ -67,6 +67,11 @@ Result<balloon::v1::SubmitJobRequest> simulate_request_from_args(const ParsedArg
     if (!value) return fail(value.error());
     parameters.thickness_mm = *value;
   }
+  if (const auto text = args.get("size")) {
+    Result<double> value = parse_number("size", *text);
+    if (!value) return fail(value.error());
+    parameters.size_mm = *value;
+  }
   if (const auto text = args.get("pressure")) {
     Result<double> value = parse_number("pressure", *text);
     if (!value) return fail(value.error());
@@ -101,6 +106,7 @@ Result<balloon::v1::SubmitJobRequest> simulate_request_from_args(const ParsedArg
   if (const std::vector<jobs::FieldProblem> problems = jobs::simulate_parameter_problems(parameters); !problems.empty())
     return fail(message_naming_flags("simulate", problems));
   job->set_thickness_mm(parameters.thickness_mm);
+  job->set_size_mm(parameters.size_mm);
   if (parameters.pressure_kpa) job->set_pressure_kpa(*parameters.pressure_kpa);
   if (parameters.volume_ratio) job->set_volume_ratio(*parameters.volume_ratio);
   if (const auto& curve = parameters.curve) {

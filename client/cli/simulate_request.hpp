@@ -10,7 +10,7 @@
 
 namespace balloon::cli {
 
-/// --material, --thickness, --pressure, --volume-ratio, and for a curve --volume-ratio-range or
+/// --material, --thickness, --size, --pressure, --volume-ratio, and for a curve --volume-ratio-range or
 /// --pressure-range with --points.
 std::vector<OptionSpec> simulate_option_specs();
 

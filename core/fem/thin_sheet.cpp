@@ -18,7 +18,7 @@ std::string thin_sheet_problem(double thickness_mm, double rest_diagonal_mm) {
     out << "far thicker than";
   out << " the uninflated balloon's size (bounding-box diagonal " << rest_diagonal_mm
       << " mm); the thin-sheet model needs at most " << 100.0 * MAX_THICKNESS_PER_DIAGONAL
-      << "%. Mesh coordinates are read as mm: scale the mesh up (design: --size MM) or give a thinner --thickness";
+      << "%. Mesh coordinates are read as mm: scale the mesh up (--size MM) or give a thinner --thickness";
   return out.str();
 }
 

@@ -11,6 +11,9 @@
 namespace balloon::jobs {
 namespace {
 
+/// A balloon a kilometre across is surely a unit mistake; it also keeps the scaled coordinates finite.
+constexpr double MAX_SIZE_MM = 1e6;
+
 std::string format_number(double value, const char* format = "%.6g") {
   char buffer[64];
   std::snprintf(buffer, sizeof(buffer), format, value);
@@ -23,6 +26,9 @@ std::vector<FieldProblem> simulate_parameter_problems(const SimulateParameters& 
   std::vector<FieldProblem> problems;
   if (!std::isfinite(parameters.thickness_mm) || parameters.thickness_mm <= 0.0)
     problems.push_back({"thickness_mm", "thickness must be a positive number of mm, got " + format_number(parameters.thickness_mm)});
+  if (!std::isfinite(parameters.size_mm) || parameters.size_mm < 0.0 || parameters.size_mm > MAX_SIZE_MM)
+    problems.push_back({"size_mm", "size must be a number of mm up to " + format_number(MAX_SIZE_MM) +
+                                       " (or 0 to keep the mesh's size), got " + format_number(parameters.size_mm)});
   const int controls = (parameters.pressure_kpa ? 1 : 0) + (parameters.volume_ratio ? 1 : 0) + (parameters.curve ? 1 : 0);
   if (controls > 1)
     problems.push_back({"pressure_kpa", parameters.curve ? "give a curve range or a single pressure or volume ratio, not both"
@@ -53,6 +59,11 @@ Result<SimulateInput> prepare_simulate(TriMesh rest, const Material& material,
   if (const std::string problem = material_problem(material); !problem.empty())
     return fail("material: " + problem);
 
+  if (parameters.size_mm > 0.0) {
+    const double diagonal = bounding_box_diagonal(rest.vertices);
+    if (!(diagonal > 0.0) || !std::isfinite(diagonal)) return fail("mesh: it has no extent to scale to size_mm");
+    rest.vertices *= parameters.size_mm / diagonal;
+  }
   Result<MeshCheckReport> report = validate_balloon_mesh(rest);
   if (!report) return fail("mesh: " + report.error());
   if (const std::string problem = thin_sheet_problem(parameters.thickness_mm, bounding_box_diagonal(rest.vertices));

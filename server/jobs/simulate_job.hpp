@@ -30,6 +30,7 @@ struct CurveParameters {
 /// How a user asked to load the membrane. Exactly one of pressure_kpa, volume_ratio and curve is set.
 struct SimulateParameters {
   double thickness_mm = DEFAULT_THICKNESS_MM;  ///< rest thickness h (mm), > 0
+  double size_mm = 0.0;                        ///< scale the rest mesh to this bbox diagonal (mm); 0 keeps it
   std::optional<double> pressure_kpa;          ///< pressure control (kPa), > 0
   std::optional<double> volume_ratio;          ///< volume control: target V / V_rest, > 0
   std::optional<CurveParameters> curve;        ///< the whole curve in one run
@@ -48,12 +49,12 @@ struct SimulateInput {
 };
 
 /// Empty when the parameters are usable, else one problem per bad field, named by its SimulateJob field
-/// ("thickness_mm", "pressure_kpa" when no or several controls are given, "volume_ratio",
+/// ("thickness_mm", "size_mm", "pressure_kpa" when no or several controls are given, "volume_ratio",
 /// "curve.volume_ratio_range" or "curve.pressure_range" for a bad range, "curve.points").
 std::vector<FieldProblem> simulate_parameter_problems(const SimulateParameters& parameters);
 
-/// Checks the parameters, the material constants and the mesh (closed, manifold, finite, ...); an
-/// inward-oriented mesh is flipped. The error names the problem (and the face or vertex).
+/// Checks the parameters, the material constants and the mesh (closed, manifold, finite, ...), after
+/// scaling it to `size_mm` when that is set; an inward-oriented mesh is flipped. The error names the problem (and the face or vertex).
 Result<SimulateInput> prepare_simulate(TriMesh rest, const Material& material,
                                        const SimulateParameters& parameters);
 

@@ -20,6 +20,7 @@ ServiceStatus load_simulate(const v1::SimulateJob& job, const std::string& tenan
 
   jobs::SimulateParameters parameters;
   parameters.thickness_mm = job.thickness_mm() == 0.0 ? jobs::DEFAULT_THICKNESS_MM : job.thickness_mm();
+  parameters.size_mm = job.size_mm();
   if (job.control_case() == v1::SimulateJob::kPressureKpa) parameters.pressure_kpa = job.pressure_kpa();
   if (job.control_case() == v1::SimulateJob::kVolumeRatio) parameters.volume_ratio = job.volume_ratio();
   if (job.control_case() == v1::SimulateJob::kCurve) {

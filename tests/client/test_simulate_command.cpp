@@ -8,6 +8,8 @@
 #include <sstream>
 
 #include "cli_test_support.hpp"
+#include "mesh/mesh_geometry.hpp"
+#include "mesh/mesh_io.hpp"
 
 namespace balloon::testing {
 namespace {
@@ -107,6 +109,32 @@ TEST_F(SimulateCommand, NotConvergedPrintsTheResultExitsThreeAndWritesNoFile) {
   EXPECT_EQ(json_field(result.out, "stop_reason"), "\"above_max_pressure\"") << result.out;
   EXPECT_TRUE(json_field(result.out, "residual_norm").has_value());
   EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST_F(SimulateCommand, SizeScalesAMeshDrawnInOtherUnitsToMillimetres) {
+  // The suite's 10 mm sphere drawn in centimetres: 1 unit across radius, read as 1 mm, is refused (a
+  // 0.5 mm sheet on a 3.4 mm balloon), and `--size` with the 10 mm sphere's diagonal makes it that sphere:
+  // the same rest volume and the thin-sphere pressure of the test above.
+  const ProcessResult made = run({"mesh", "sphere", "--radius", "1", "--subdivisions", "3", "--out", s_scratch->file("cm.obj")});
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  expect_bad_input({"simulate", s_scratch->file("cm.obj"), "--material", "neo-hookean:mu=0.3", "--volume-ratio", "8"},
+                   "--size MM");
+  const Result<TriMesh> millimetres = read_mesh(sphere());
+  ASSERT_TRUE(millimetres) << millimetres.error();
+  std::ostringstream size;
+  size.precision(17);
+  size << bounding_box_diagonal(millimetres->vertices);
+  const ProcessResult scaled = run({"simulate", s_scratch->file("cm.obj"), "--material", "neo-hookean:mu=0.3", "--size",
+                                    size.str(), "--volume-ratio", "8", "--json"});
+  ASSERT_EQ(scaled.exit_code, 0) << scaled.err;
+  const ProcessResult reference = run({"simulate", sphere(), "--material", "neo-hookean:mu=0.3", "--volume-ratio", "8", "--json"});
+  ASSERT_EQ(reference.exit_code, 0) << reference.err;
+  EXPECT_NEAR(json_number_field(scaled.out, "rest_volume_mm3"), json_number_field(reference.out, "rest_volume_mm3"),
+              1e-9 * json_number_field(reference.out, "rest_volume_mm3"));
+  EXPECT_NEAR(json_number_field(scaled.out, "pressure_kpa"), json_number_field(reference.out, "pressure_kpa"),
+              1e-6 * json_number_field(reference.out, "pressure_kpa"));
+  expect_bad_input({"simulate", sphere(), "--material", "latex", "--volume-ratio", "2", "--size", "-10"},
+                   "--size: size must be a number of mm");
 }
 
 TEST_F(SimulateCommand, InwardMeshIsFlippedAndSaysSo) {

@@ -391,6 +391,11 @@ TEST(HostileInputs, CatalogueGetsItsStatusesAndTheServerStaysServingAndSmall) {
     thickness.mutable_spec()->mutable_simulate()->set_thickness_mm(v);
     submit_case("simulate thickness_mm " + number_name(v), thickness, v == 0.0 ? StatusCode::OK : StatusCode::INVALID_ARGUMENT,
                 v == 0.0 ? "" : v == 1e308 ? "thin-sheet model" : "thickness must be a positive number of mm");
+    // size_mm 0 keeps the mesh's size; beyond 1e6 mm (1e308) it is a unit mistake.
+    v1::SubmitJobRequest size = good_simulate();
+    size.mutable_spec()->mutable_simulate()->set_size_mm(v);
+    submit_case("simulate size_mm " + number_name(v), size, v == 0.0 ? StatusCode::OK : StatusCode::INVALID_ARGUMENT,
+                v == 0.0 ? "" : "size must be a number of mm up to");
     v1::SubmitJobRequest pressure = good_simulate();
     pressure.mutable_spec()->mutable_simulate()->set_pressure_kpa(v);
     submit_case("simulate pressure_kpa " + number_name(v), pressure, v == 1e308 ? StatusCode::OK : StatusCode::INVALID_ARGUMENT,
