@@ -384,6 +384,7 @@ class InflationRun {
         message = "no equilibrium found at volume ratio " + format_number(next / m_model.volume(flat_rest())) +
                   " (" + report.message + ", residual " + format_number(report.residual_norm) + " N against a tolerance of " +
                   format_number(m_settings.relative_tolerance * m_solver.force_scale(state.x, state.pressure)) + " N)";
+        if (report.stop == NewtonStop::NonFinite) message += stiffening_overflow(state);
         return false;
       }
     }
@@ -632,6 +633,20 @@ class InflationRun {
     }
     state = closer;
     return false;
+  }
+
+  /// Why a Hart-Smith path ends in non-finite numbers, in physical terms: its stiffening exp(k1 (I1 - 3)^2)
+  /// outgrows double precision (hart-smith:G=0.1,k1=10,k2=1 ended "non-finite residual" past x10.5, at a
+  /// pressure of 8e154 kPa). Empty unless the last equilibrium's pressure was above 1 GPa, which no rubber
+  /// sheet bears (their tensile strengths are tens of MPa).
+  std::string stiffening_overflow(const PathPoint& state) const {
+    constexpr double NO_RUBBER_BEARS_MPA = 1e3;
+    if (m_options.material.model != MaterialModel::HartSmith || !(state.pressure > NO_RUBBER_BEARS_MPA)) return "";
+    return "; this rubber's Hart-Smith stiffening exp(k1 (I1 - 3)^2) (k1 = " + format_number(m_options.material.params[1]) +
+           ") outgrows the numbers a computer holds: at the last equilibrium (volume ratio " +
+           format_number(state.volume / m_model.volume(flat_rest())) + ", largest stretch " +
+           format_number(m_model.max_stretch(state.x)) + ") the pressure was already " + format_kpa(state.pressure) +
+           ", far beyond what any rubber bears before it bursts";
   }
 
   void fill(InflationResult& result, const PathPoint& state) {

@@ -131,6 +131,29 @@ TEST(Inflation, PressureAboveTheMaximumIsReportedNotCrashed) {
   EXPECT_TRUE(result.deformed.allFinite());
 }
 
+TEST(Inflation, ARubberThatStiffensBeyondDoublePrecisionSaysSoInPhysicalTerms) {
+  // Hart-Smith with k1 = 10 (fitted rubbers: 3e-4 to 0.03): exp(k1 (I1 - 3)^2) overflows on the way to x27.
+  // The path ends at its last equilibrium, where the pressure is already beyond 1 GPa, and says why in
+  // those terms rather than only "non-finite residual".
+  const TriMesh sphere = make_icosphere(10.0, 2);
+  InflationOptions options;
+  options.material = make(MaterialModel::HartSmith, 0.1, 10.0, 1.0);
+  options.volume_ratio = 27.0;
+  const InflationResult result = inflate(sphere, options);
+  EXPECT_FALSE(result.converged);
+  EXPECT_EQ(result.stop, InflationStop::NoEquilibrium);
+  EXPECT_NE(result.message.find("outgrows the numbers a computer holds"), std::string::npos) << result.message;
+  EXPECT_NE(result.message.find("far beyond what any rubber bears"), std::string::npos) << result.message;
+  EXPECT_GT(result.pressure_kpa, 1e6);
+  EXPECT_LT(result.volume_ratio, 27.0);
+  EXPECT_TRUE(result.deformed.allFinite());
+  // A stiffening that stays in range is followed to the end, with no such words.
+  options.material = make(MaterialModel::HartSmith, 0.1, 0.01, 1.0);
+  const InflationResult tame = inflate(sphere, options);
+  EXPECT_TRUE(tame.converged) << tame.message;
+  EXPECT_EQ(tame.message.find("outgrows"), std::string::npos) << tame.message;
+}
+
 TEST(Inflation, PressureAboveAMaximumThatTheStiffeningRubberClimbsBackToSnapsToTheFarBranch) {
   // A Mooney-Rivlin sphere's pressure rises to a maximum, falls, and climbs again as the C2 term
   // stiffens it: above the maximum the balloon snaps to the far branch, where p matches the closed form.
