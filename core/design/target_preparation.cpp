@@ -93,8 +93,7 @@ Result<PreparedTarget> prepare_target(TriMesh target, const TargetPreparationOpt
 
   const double diagonal = bounding_box_diagonal(target.vertices);
   if (options.size_mm > 0.0) {
-    out.scale_factor = options.size_mm / diagonal;
-    target.vertices *= out.scale_factor;
+    out.scale_factor = scale_to_diagonal(target.vertices, options.size_mm);
     out.summary += "scaled by " + format("%.6g", out.scale_factor) + " (bounding-box diagonal " +
                    format("%.6g", diagonal) + " -> " + format("%.6g", options.size_mm) + " mm)\n";
   }

@@ -39,6 +39,13 @@ double bounding_box_diagonal(const Positions& vertices) {
   return (vertices.colwise().maxCoeff() - vertices.colwise().minCoeff()).norm();
 }
 
+double scale_to_diagonal(Positions& vertices, double diagonal_mm) {
+  const double factor = diagonal_mm / bounding_box_diagonal(vertices);
+  if (!std::isfinite(factor) || !(factor > 0.0)) return 0.0;
+  vertices *= factor;
+  return factor;
+}
+
 Eigen::RowVector3d centroid(const Positions& vertices) {
   if (vertices.rows() == 0) return Eigen::RowVector3d::Zero();
   return vertices.colwise().mean();

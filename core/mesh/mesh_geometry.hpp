@@ -19,6 +19,10 @@ double surface_area(const Positions& vertices, const Faces& faces);
 /// Length (mm) of the diagonal of the axis-aligned bounding box of all rows of V (#V x 3); 0 if empty.
 double bounding_box_diagonal(const Positions& vertices);
 
+/// Scales V about the origin so that its bounding-box diagonal is `diagonal_mm` (mm), as `--size` asks;
+/// returns the factor, or 0 (V unchanged) when V has no finite, positive extent to scale.
+double scale_to_diagonal(Positions& vertices, double diagonal_mm);
+
 /// Mean of the rows of V (#V x 3, mm); a cheap centre for meshes with roughly uniform sampling.
 Eigen::RowVector3d centroid(const Positions& vertices);
 

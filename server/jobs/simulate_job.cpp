@@ -59,11 +59,8 @@ Result<SimulateInput> prepare_simulate(TriMesh rest, const Material& material,
   if (const std::string problem = material_problem(material); !problem.empty())
     return fail("material: " + problem);
 
-  if (parameters.size_mm > 0.0) {
-    const double diagonal = bounding_box_diagonal(rest.vertices);
-    if (!(diagonal > 0.0) || !std::isfinite(diagonal)) return fail("mesh: it has no extent to scale to size_mm");
-    rest.vertices *= parameters.size_mm / diagonal;
-  }
+  if (parameters.size_mm > 0.0 && scale_to_diagonal(rest.vertices, parameters.size_mm) == 0.0)
+    return fail("mesh: it has no extent to scale to size_mm");
   Result<MeshCheckReport> report = validate_balloon_mesh(rest);
   if (!report) return fail("mesh: " + report.error());
   if (const std::string problem = thin_sheet_problem(parameters.thickness_mm, bounding_box_diagonal(rest.vertices));

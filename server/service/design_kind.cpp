@@ -32,7 +32,7 @@ std::string nozzle_problem(TriMesh target, const jobs::DesignParameters& paramet
   if (parameters.nozzle.empty()) return "";
   const Result<NozzleSpec> nozzle = parse_nozzle(parameters.nozzle);
   if (!nozzle || nozzle->automatic) return "";
-  if (parameters.size_mm > 0.0) target.vertices *= parameters.size_mm / bounding_box_diagonal(target.vertices);
+  if (parameters.size_mm > 0.0) scale_to_diagonal(target.vertices, parameters.size_mm);
   // A point on the surface lies within one edge of a vertex; remeshing moves the vertices, not the
   // surface. So only a centre farther than the longest edge is judged now, by the worker's own rule.
   double longest_edge = 0.0;

@@ -24,6 +24,19 @@ TEST(MeshGeometry, UnitCubeMeasures) {
   EXPECT_NEAR(min_angle_deg(cube.vertices, cube.faces), 45.0, 1e-12);
 }
 
+TEST(MeshGeometry, ScaleToDiagonalScalesAboutTheOriginOrLeavesNoExtentAlone) {
+  TriMesh cube = unit_cube();
+  EXPECT_NEAR(scale_to_diagonal(cube.vertices, 100.0), 100.0 / std::sqrt(3.0), 1e-12);
+  EXPECT_NEAR(bounding_box_diagonal(cube.vertices), 100.0, 1e-12);
+  EXPECT_NEAR(enclosed_volume(cube.vertices, cube.faces), std::pow(100.0 / std::sqrt(3.0), 3), 1e-6);
+  EXPECT_TRUE(cube.vertices.row(0).isZero()) << "the corner at the origin stays there";
+  Positions point = Positions::Constant(3, 3, 2.0);
+  EXPECT_EQ(scale_to_diagonal(point, 100.0), 0.0);
+  EXPECT_TRUE((point.array() == 2.0).all());
+  Positions none(0, 3);
+  EXPECT_EQ(scale_to_diagonal(none, 100.0), 0.0);
+}
+
 TEST(MeshGeometry, VolumeIsSignedAndTranslationInvariant) {
   TriMesh cube = unit_cube();
   cube.vertices.rowwise() += Eigen::RowVector3d(100.0, -50.0, 3.0);
