@@ -644,7 +644,7 @@ class InflationRun {
     if (m_options.material.model != MaterialModel::HartSmith || !(state.pressure > NO_RUBBER_BEARS_MPA)) return "";
     return "; this rubber's Hart-Smith stiffening exp(k1 (I1 - 3)^2) (k1 = " + format_number(m_options.material.params[1]) +
            ") outgrows the numbers a computer holds: at the last equilibrium (volume ratio " +
-           format_number(state.volume / m_model.volume(flat_rest())) + ", largest stretch " +
+           format_number(state.volume / m_rest_volume) + ", largest stretch " +
            format_number(m_model.max_stretch(state.x)) + ") the pressure was already " + format_kpa(state.pressure) +
            ", far beyond what any rubber bears before it bursts";
   }
