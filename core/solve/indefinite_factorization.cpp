@@ -73,19 +73,16 @@ struct IndefiniteFactorization::Internals {
     dmumps_c(&mumps);
   }
 
-  /// Hands MUMPS a workspace of at least `entries` (LWK_USER counts entries, or millions of them when
-  /// negative, for sizes beyond an int).
+  /// Hands MUMPS a workspace of at least `entries`; beyond what LWK_USER's int counts (16 GB), none: MUMPS
+  /// then allocates its own.
   void use_workspace(size_t entries) {
-    constexpr size_t MILLION = 1000000;
-    if (entries > static_cast<size_t>(std::numeric_limits<int>::max())) entries = (entries / MILLION + 1) * MILLION;
-    if (workspace.size() < entries) {
-      workspace = std::vector<double>();  // the old one first: never both at once
-      workspace.resize(entries);
-    }
+    workspace = std::vector<double>();  // the old one first: never both at once
+    mumps.wk_user = nullptr;
+    mumps.lwk_user = 0;
+    if (entries > static_cast<size_t>(std::numeric_limits<int>::max())) return;
+    workspace.resize(entries);
     mumps.wk_user = workspace.data();
-    mumps.lwk_user = workspace.size() > static_cast<size_t>(std::numeric_limits<int>::max())
-                         ? -static_cast<int>(workspace.size() / MILLION)
-                         : static_cast<int>(workspace.size());
+    mumps.lwk_user = static_cast<int>(entries);
   }
 };
 
@@ -141,9 +138,10 @@ IndefiniteFactorization::Status IndefiniteFactorization::factorize(const std::ve
     if (mumps.infog[0] < 0) return Status::Failed;
     m->analysed = true;
     // INFO(8): the estimated size of S, in millions of entries when negative; half as much again for
-    // delayed pivots.
+    // delayed pivots. A workspace that is large enough already is kept.
     const double estimate = mumps.info[7] >= 0 ? mumps.info[7] : -1e6 * mumps.info[7];
-    if (estimate * sizeof(double) > GLIBC_LARGEST_RECYCLED_BLOCK) m->use_workspace(static_cast<size_t>(1.5 * estimate) + 1);
+    if (estimate * sizeof(double) > GLIBC_LARGEST_RECYCLED_BLOCK && m->workspace.size() < estimate)
+      m->use_workspace(static_cast<size_t>(1.5 * estimate) + 1);
   }
   // Delayed pivots can outgrow the workspace estimated at analysis: grow it and factorize again.
   for (int attempt = 0;; ++attempt) {

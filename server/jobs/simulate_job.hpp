@@ -54,7 +54,8 @@ struct SimulateInput {
 std::vector<FieldProblem> simulate_parameter_problems(const SimulateParameters& parameters);
 
 /// Checks the parameters, the material constants and the mesh (closed, manifold, finite, ...), after
-/// scaling it to `size_mm` when that is set; an inward-oriented mesh is flipped. The error names the problem (and the face or vertex).
+/// scaling it to `size_mm` when that is set; an inward-oriented mesh is flipped. The error names the
+/// problem (and the face or vertex).
 Result<SimulateInput> prepare_simulate(TriMesh rest, const Material& material,
                                        const SimulateParameters& parameters);
 
