@@ -7,6 +7,7 @@
 #include "design/mold.hpp"
 #include "fem/thin_sheet.hpp"
 #include "jobs/json_writer.hpp"
+#include "jobs/mesh_size.hpp"
 #include "mesh/mesh_geometry.hpp"
 
 namespace balloon::jobs {
@@ -71,9 +72,7 @@ std::vector<FieldProblem> design_parameter_problems(const DesignParameters& para
   const auto problem = [&](const char* field, std::string message) { problems.push_back({field, std::move(message)}); };
   if (!std::isfinite(parameters.thickness_mm) || parameters.thickness_mm <= 0.0)
     problem("thickness_mm", "thickness must be a positive number of mm, got " + format_number(parameters.thickness_mm));
-  if (!std::isfinite(parameters.size_mm) || parameters.size_mm < 0.0)
-    problem("size_mm", "size must be a positive number of mm (or 0 to keep the target's size), got " +
-                           format_number(parameters.size_mm));
+  if (std::string size = size_mm_problem(parameters.size_mm); !size.empty()) problem("size_mm", std::move(size));
   if (parameters.resolution < 0)
     problem("resolution", "resolution must be >= 0 vertices (0 never remeshes)");
   else if (parameters.resolution > 0 && parameters.resolution < 50)

@@ -5,14 +5,12 @@
 #include <sstream>
 
 #include "fem/thin_sheet.hpp"
+#include "jobs/mesh_size.hpp"
 #include "mesh/mesh_checks.hpp"
 #include "mesh/mesh_geometry.hpp"
 
 namespace balloon::jobs {
 namespace {
-
-/// A balloon a kilometre across is surely a unit mistake; it also keeps the scaled coordinates finite.
-constexpr double MAX_SIZE_MM = 1e6;
 
 std::string format_number(double value, const char* format = "%.6g") {
   char buffer[64];
@@ -26,9 +24,7 @@ std::vector<FieldProblem> simulate_parameter_problems(const SimulateParameters& 
   std::vector<FieldProblem> problems;
   if (!std::isfinite(parameters.thickness_mm) || parameters.thickness_mm <= 0.0)
     problems.push_back({"thickness_mm", "thickness must be a positive number of mm, got " + format_number(parameters.thickness_mm)});
-  if (!std::isfinite(parameters.size_mm) || parameters.size_mm < 0.0 || parameters.size_mm > MAX_SIZE_MM)
-    problems.push_back({"size_mm", "size must be a number of mm up to " + format_number(MAX_SIZE_MM) +
-                                       " (or 0 to keep the mesh's size), got " + format_number(parameters.size_mm)});
+  if (std::string size = size_mm_problem(parameters.size_mm); !size.empty()) problems.push_back({"size_mm", std::move(size)});
   const int controls = (parameters.pressure_kpa ? 1 : 0) + (parameters.volume_ratio ? 1 : 0) + (parameters.curve ? 1 : 0);
   if (controls > 1)
     problems.push_back({"pressure_kpa", parameters.curve ? "give a curve range or a single pressure or volume ratio, not both"
