@@ -381,7 +381,7 @@ class InflationRun {
       }
       step *= 0.5;
       if (std::abs(step) < smallest) {
-        message = "no equilibrium found at volume ratio " + format_number(next / m_model.volume(flat_rest())) +
+        message = "no equilibrium found at volume ratio " + format_number(next / m_rest_volume) +
                   " (" + report.message + ", residual " + format_number(report.residual_norm) + " N against a tolerance of " +
                   format_number(m_settings.relative_tolerance * m_solver.force_scale(state.x, state.pressure)) + " N)";
         if (report.stop == NewtonStop::NonFinite) message += stiffening_overflow(state);
@@ -483,10 +483,6 @@ class InflationRun {
     return true;
   }
 
-  Eigen::VectorXd flat_rest() const {
-    return Eigen::Map<const Eigen::VectorXd>(m_rest.vertices.data(), m_rest.vertices.size());
-  }
-
   /// Pressure control: follow the volume path until the pressure reaches the target, then solve at
   /// that pressure. A target above the balloon's pressure maximum has no equilibrium and says so.
   bool inflate_to_pressure(PathPoint& state, double target_pressure, std::string& message) {
@@ -494,7 +490,7 @@ class InflationRun {
       message = "pressure must be positive";
       return false;
     }
-    const double rest_volume = m_model.volume(flat_rest());
+    const double rest_volume = m_rest_volume;
     double step = 0.5 * rest_volume;
     // The highest pressure on the path so far, and where; past a maximum below the target the path goes
     // on, for the pressure may climb again (a lobe that popped, a stiffening rubber's third branch).
