@@ -242,9 +242,8 @@ ServiceStatus JobHandler::submit(const Caller& caller, const v1::SubmitJobReques
   }
   record.request_id = request_id;
   {
-    // Two copies of one request in flight at once: the second finds the first here.
-    std::unique_lock request_lock(m_request_mutex, std::defer_lock);
-    if (!request_id.empty()) request_lock.lock();
+    // Two copies of one request in flight at once: the second waits for the first and finds it here.
+    const RequestClaims::Claim claim = m_request_claims.claim(caller.tenant, request_id);
     try {
       if (const auto first = first_submission()) {
         m_queue.release_reservation(caller.tenant);

@@ -19,6 +19,7 @@
 #include "service/job_kind.hpp"
 #include "service/job_queue.hpp"
 #include "service/material_handler.hpp"
+#include "service/request_claims.hpp"
 #include "service/service_options.hpp"
 #include "service/service_status.hpp"
 #include "service/watch_channel.hpp"
@@ -114,7 +115,7 @@ class JobHandler {
   std::mutex m_prepared_mutex;
   std::map<std::int64_t, std::shared_ptr<const void>> m_prepared;
 
-  std::mutex m_request_mutex;  // held from the request_id lookup to the insert
+  RequestClaims m_request_claims;  // each request_id held from its lookup to its insert
   std::mutex m_id_mutex;
   std::uint64_t m_id_state = 0;
 };
