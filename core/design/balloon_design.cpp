@@ -56,6 +56,9 @@ std::string options_problem(const TriMesh& target, const DesignOptions& options)
   if (!(options.k_length >= 0.0 && options.k_bending >= 0.0 && options.k_surface >= 0.0) ||
       !std::isfinite(options.k_length + options.k_bending + options.k_surface))
     return "the objective's weights must be finite and not negative";
+  if (!(options.surface_growth >= 1.0 && options.max_surface_growth >= 1.0) ||
+      !std::isfinite(options.surface_growth * options.max_surface_growth) || options.surface_growth_iterations < 1)
+    return "the surface term's growth must be a finite factor of at least 1, after at least 1 iteration";
   if (options.initial_rest.rows() != 0) {
     if (options.initial_rest.rows() != target.vertex_count() || !options.initial_rest.allFinite())
       return "the initial rest shape must have one finite position per target vertex";

@@ -298,6 +298,7 @@ DesignResult& DesignDriver::finish(DesignResult& result, const Eigen::VectorXd& 
   result.rest = m_target;
   result.rest.vertices = unflatten(rest);
   result.time_s = design_clock_s() - m_start;
+  result.surface_weight = m_objective.surface_weight();
   const bool inflated = !result.log.empty();
   result.converged = inflated && m_final_equilibrium &&
                      (result.stop == DesignStop::Matched || result.stop == DesignStop::Optimal);

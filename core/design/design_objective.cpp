@@ -1,5 +1,6 @@
 #include "design/design_objective.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "mesh/mesh_geometry.hpp"
@@ -46,7 +47,21 @@ DesignObjective::DesignObjective(const TriMesh& target, const TriMesh& start, co
   // bending part of eq. 18 against the start) take part.
   m_rest_bending_active = (m_start_hinges.rest_angles().array().abs() < COPLANAR_HINGE_RAD).any();
   const double diag = m_surface.bbox_diagonal_mm();
-  m_surface_weight = options.k_surface * m_distance.rest_lengths().sum() / (diag * diag * target.vertex_count());
+  m_unit_surface_weight = m_distance.rest_lengths().sum() / (diag * diag * target.vertex_count());
+  m_k_surface = options.k_surface;
+  m_surface_weight = m_k_surface * m_unit_surface_weight;
+  m_surface_growth = options.surface_growth;
+  m_max_surface_growth = options.max_surface_growth;
+  m_surface_growth_iterations = options.surface_growth_iterations;
+}
+
+bool DesignObjective::grow_surface_weight(int iterations) {
+  const double growth = std::min(m_max_surface_growth,
+                                 std::pow(m_surface_growth, std::max(0, iterations) / m_surface_growth_iterations));
+  if (growth == m_surface_growth_now) return false;
+  m_surface_growth_now = growth;
+  m_surface_weight = m_k_surface * growth * m_unit_surface_weight;
+  return m_surface_weight > 0.0;
 }
 
 double DesignObjective::value(const Eigen::VectorXd& rest, const Eigen::VectorXd& x) const {

@@ -38,6 +38,12 @@ class DesignObjective {
   /// Adds the gradient of regularizer_value to `gradient`.
   void add_regularizer_gradient(const Eigen::VectorXd& rest, Eigen::Ref<Eigen::VectorXd> gradient) const;
 
+  /// Sets E_surf's weight to k_surface times its growth after `iterations` iterations (see
+  /// DesignOptions::surface_growth); true when that changed it, i.e. value() and its gradient changed.
+  bool grow_surface_weight(int iterations);
+  /// k_surface times the growth set last (dimensionless).
+  double surface_weight() const { return m_k_surface * m_surface_growth_now; }
+
   /// Gauss-Newton Hessian of E_surf, point-to-plane, as triplets shifted by dof_offset.
   void add_surface_hessian(const Eigen::VectorXd& x, std::vector<Eigen::Triplet<double>>& triplets,
                            int dof_offset) const;
@@ -77,6 +83,10 @@ class DesignObjective {
   bool m_collision_seen = false;
   bool m_rest_bending_active = false;
   double m_surface_weight = 0.0;     ///< w of E_surf = w sum_i d_i^2 (mm^-1); 0 when k_surface is 0
+  double m_unit_surface_weight = 0.0;  ///< w for k_surface = 1 (mm^-1)
+  double m_k_surface = 0.0;
+  double m_surface_growth = 1.0, m_max_surface_growth = 1.0, m_surface_growth_now = 1.0;
+  int m_surface_growth_iterations = 1;
   double m_max_volume_weight = 0.0;  ///< alm: weight of -V(rest) once a region turned inside out (mm^-2)
   double m_start_volume = 0.0;       ///< the start's rest volume (mm^3)
 };

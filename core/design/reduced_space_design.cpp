@@ -90,6 +90,7 @@ class ReducedSpaceDesign {
       m_driver.record(result, m_options.resume->iteration, resumed, rest);
       m_driver.remember_if_best(rest, resumed.avg_mm);
       stall_reference = resumed.avg_mm;
+      m_objective.grow_surface_weight(m_options.resume->iteration);  // where the interrupted design had it
       m_driver.debug_time("resumed from the checkpoint");
     }
     Eigen::VectorXd gradient;
@@ -247,6 +248,20 @@ class ReducedSpaceDesign {
       if (small_decreases >= 3) {
         stop_with(result, DesignStop::Stalled, "stalled: the objective fell by less than 1e-7 in 3 iterations");
         break;
+      }
+      if (m_objective.grow_surface_weight(iteration)) {
+        // A new objective: its value, gradient, preconditioner and curvature pairs start over. The count
+        // towards a stall goes on: a design whose error no growth moves is still stalled.
+        objective = m_objective.value(rest, m_x);
+        m_lbfgs.clear();
+        if (!objective_gradient(rest, gradient)) {
+          stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized");
+          break;
+        }
+        build_preconditioner();
+        stall_objective = objective;
+        m_driver.debug_time("surface term grown");
+        continue;
       }
       if (stats.avg_mm < (1.0 - STALL_IMPROVEMENT) * stall_reference) {
         stall_reference = stats.avg_mm;

@@ -123,6 +123,7 @@ v1::DesignReport design_report(const jobs::DesignInput& input, const jobs::Desig
     report.set_improvement_over_baseline(*value);
   if (const std::optional<double> value = result.distance_energy) report.set_distance_energy(*value);
   if (const std::optional<double> value = result.residual_norm) report.set_residual_norm(*value);
+  report.set_surface_weight(result.surface_weight);
   report.set_material(material_spec(input.material));
   report.set_material_name(input.material.name);
   report.set_thickness_mm(input.parameters.thickness_mm);

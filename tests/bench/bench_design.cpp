@@ -10,6 +10,7 @@
 // Usage: bench_design [OUT_DIR=./bench-design-out] [--data DIR] [--corpus] [--mesh SUBSTRING]...
 //                     [--material silicone|latex|SPEC]... [--resolution N=3000 (4000 with --corpus)]
 //                     [--max-time S=60] [--volume-ratio R=8] [--method adjoint|alm (default: both)]
+//                     [--coarse-vertices N] [--surface-growth F (DesignOptions::surface_growth; 1: off)]
 //                     [--quick]   (--quick: bunny only, 1000 vertices, 20 s per design)
 #include <algorithm>
 #include <cstdio>
@@ -107,6 +108,7 @@ int main(int argc, char** argv) {
   bool corpus = false;
   double volume_ratio = 8.0;
   int coarse_vertices = balloon::DesignOptions{}.coarse_vertices;  // 0: full resolution only
+  double surface_growth = balloon::DesignOptions{}.surface_growth;  // 1: the surface term's weight stays
   std::vector<std::string> mesh_filters, material_specs;
   std::vector<balloon::DesignMethod> methods = {balloon::DesignMethod::Adjoint,
                                                 balloon::DesignMethod::AugmentedLagrangian};
@@ -135,6 +137,8 @@ int main(int argc, char** argv) {
       methods = {*method};
     } else if (arg == "--coarse-vertices" && i + 1 < argc) {
       coarse_vertices = std::atoi(argv[++i]);
+    } else if (arg == "--surface-growth" && i + 1 < argc) {
+      surface_growth = std::atof(argv[++i]);
     } else if (arg == "--volume-ratio" && i + 1 < argc) {
       volume_ratio = std::atof(argv[++i]);
     } else if (!arg.empty() && arg[0] != '-') {
@@ -142,7 +146,7 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: bench_design [OUT_DIR] [--data DIR] [--corpus] [--mesh SUBSTRING]... [--material SPEC]... "
-                   "[--resolution N] [--max-time S] [--volume-ratio R] [--method adjoint|alm] [--coarse-vertices N] "
+                   "[--resolution N] [--max-time S] [--volume-ratio R] [--method adjoint|alm] [--coarse-vertices N] [--surface-growth F] "
                    "[--quick]\n");
       return 2;
     }
@@ -222,6 +226,7 @@ int main(int argc, char** argv) {
         options.method = method;
         options.max_time_s = max_time_s;
         options.coarse_vertices = coarse_vertices;
+        options.surface_growth = surface_growth;
         balloon::bench::reset_peak_memory();
         runs.push_back({shape.name, material_label, balloon::design_balloon(target->mesh, options)});
         const double peak_mb = balloon::bench::peak_memory_mb();

@@ -115,7 +115,7 @@ TEST_F(DesignCommand, SmallDesignWritesTheFiveFilesWithTheContractKeys) {
                           "bbox_diag_mm", "pressure_kpa", "volume_ratio", "iterations", "time_s", "vertices",
                           "active_terms", "baseline_avg_error_mm", "baseline_max_error_mm", "preparation",
                           "material", "thickness_mm", "distance_energy", "residual_norm", "message", "tolerance",
-                          "mold"})
+                          "mold", "surface_weight"})
     EXPECT_TRUE(json_field(json, key).has_value()) << "missing key " << key << " in " << json;
   EXPECT_EQ(json_number_field(json, "vertices"), 162.0);
   EXPECT_NEAR(json_number_field(json, "volume_ratio"), 8.0, 0.05);

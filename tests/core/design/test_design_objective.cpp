@@ -1,0 +1,81 @@
+// The design objective's surface term grows on its schedule (DesignOptions::surface_growth): by the
+// factor after every surface_growth_iterations iterations, up to its cap, and only the surface term moves.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "design/balloon_design.hpp"
+#include "design/design_objective.hpp"
+#include "fem/balloon_model.hpp"
+#include "mesh/icosphere.hpp"
+
+namespace balloon {
+namespace {
+
+TEST(DesignObjective, TheSurfaceWeightGrowsOnItsScheduleUpToItsCap) {
+  TriMesh target = make_icosphere(10.0, 2);
+  target.vertices.col(0) *= 1.5;
+  const TriMesh start = make_icosphere(5.0, 2);
+  DesignOptions options;
+  options.material = *parse_material_spec("silicone");
+  options.surface_growth = 3.0;
+  options.surface_growth_iterations = 8;
+  options.max_surface_growth = 20.0;
+  const fem::BalloonModel model(start, options.material,
+                                std::vector<double>(static_cast<size_t>(start.face_count()), options.thickness_mm));
+  DesignObjective objective(target, start, options, model);
+
+  // A shape off the target: both terms are non-zero.
+  Eigen::VectorXd x(3 * target.vertex_count());
+  for (int v = 0; v < target.vertex_count(); ++v)
+    x.segment<3>(3 * v) = 1.1 * target.vertices.row(v).transpose() + Eigen::Vector3d(0.1 * std::sin(v), 0.0, 0.0);
+  const Eigen::VectorXd rest = x;
+  const double surface = objective.surface_term(x, nullptr);
+  const double distance = objective.distance().value(x);
+  ASSERT_GT(surface, 0.0);
+  ASSERT_GT(distance, 0.0);
+  EXPECT_DOUBLE_EQ(objective.surface_weight(), 100.0);
+
+  EXPECT_FALSE(objective.grow_surface_weight(7)) << "no growth before the 8th iteration";
+  EXPECT_TRUE(objective.grow_surface_weight(8));
+  EXPECT_DOUBLE_EQ(objective.surface_weight(), 300.0);
+  EXPECT_NEAR(objective.surface_term(x, nullptr), 3.0 * surface, 1e-12 * surface);
+  EXPECT_NEAR(objective.value(rest, x), distance + 3.0 * surface, 1e-12 * (distance + surface));
+  EXPECT_FALSE(objective.grow_surface_weight(15)) << "the same growth until the 16th";
+  EXPECT_TRUE(objective.grow_surface_weight(16));
+  EXPECT_DOUBLE_EQ(objective.surface_weight(), 900.0);
+  EXPECT_TRUE(objective.grow_surface_weight(24));
+  EXPECT_DOUBLE_EQ(objective.surface_weight(), 2000.0) << "capped at 20 times k_surface";
+  EXPECT_FALSE(objective.grow_surface_weight(400));
+  // A resumed design takes the growth of its checkpoint's iteration, also backwards.
+  EXPECT_TRUE(objective.grow_surface_weight(9));
+  EXPECT_DOUBLE_EQ(objective.surface_weight(), 300.0);
+
+  // The gradient follows the weight: shape_gradient = grad E_dist + 3 grad E_surf.
+  Eigen::VectorXd distance_gradient, surface_gradient;
+  objective.distance().gradient(x, distance_gradient);
+  DesignObjective unit(target, start, options, model);
+  unit.surface_term(x, &surface_gradient);
+  EXPECT_LE((objective.shape_gradient(x) - distance_gradient - 3.0 * surface_gradient).norm(),
+            1e-12 * (distance_gradient.norm() + surface_gradient.norm()));
+}
+
+TEST(DesignObjective, AGrowthBelowOneIsRefused) {
+  TriMesh target = make_icosphere(10.0, 2);
+  DesignOptions options;
+  options.material = *parse_material_spec("silicone");
+  options.max_iterations = 1;
+  for (const auto& [growth, every, cap] : std::vector<std::tuple<double, int, double>>{
+           {0.5, 8, 1000.0}, {3.0, 0, 1000.0}, {3.0, 8, 0.5}, {NAN, 8, 1000.0}, {3.0, 8, INFINITY}}) {
+    options.surface_growth = growth;
+    options.surface_growth_iterations = every;
+    options.max_surface_growth = cap;
+    const DesignResult result = design_balloon(target, options);
+    EXPECT_EQ(result.stop, DesignStop::StartFailed);
+    EXPECT_NE(result.message.find("surface term's growth"), std::string::npos) << result.message;
+  }
+}
+
+}  // namespace
+}  // namespace balloon
