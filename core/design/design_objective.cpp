@@ -119,19 +119,39 @@ void DesignObjective::add_regularizer_gradient(const Eigen::VectorXd& rest, Eige
 
 /// Point-to-plane: 2 w n n^T per vertex with n the normal of the target triangle closest to it (sliding
 /// along the target costs nothing; E_dist governs that).
-void DesignObjective::add_surface_hessian(const Eigen::VectorXd& x, std::vector<Eigen::Triplet<double>>& triplets,
-                                          int dof_offset) const {
-  if (m_surface_weight <= 0.0) return;
+Positions DesignObjective::closest_target_normals(const Eigen::VectorXd& x) const {
   const Positions points = unflatten(x);
   Positions closest;
   Eigen::VectorXi faces;
   m_surface.closest_points(points, closest, nullptr, &faces);
+  Positions normals = Positions::Zero(points.rows(), 3);
   for (Eigen::Index v = 0; v < points.rows(); ++v) {
     const Eigen::Vector3d a = m_target.vertices.row(m_target.faces(faces[v], 0));
     const Eigen::Vector3d b = m_target.vertices.row(m_target.faces(faces[v], 1));
     const Eigen::Vector3d c = m_target.vertices.row(m_target.faces(faces[v], 2));
     const Eigen::Vector3d normal = (b - a).cross(c - a).normalized();
-    if (!normal.allFinite()) continue;
+    if (normal.allFinite()) normals.row(v) = normal.transpose();
+  }
+  return normals;
+}
+
+ObjectiveGaussNewton DesignObjective::gauss_newton(const Eigen::VectorXd& x) const {
+  std::vector<Eigen::Triplet<double>> entries;
+  m_distance.residual_jacobian_triplets(x, entries);
+  Eigen::SparseMatrix<double, Eigen::RowMajor> jacobian(m_distance.residual_count(), x.size());
+  jacobian.setFromTriplets(entries.begin(), entries.end());
+  return ObjectiveGaussNewton(std::move(jacobian),
+                              m_surface_weight > 0.0 ? closest_target_normals(x) : Positions::Zero(0, 3),
+                              m_surface_weight);
+}
+
+void DesignObjective::add_surface_hessian(const Eigen::VectorXd& x, std::vector<Eigen::Triplet<double>>& triplets,
+                                          int dof_offset) const {
+  if (m_surface_weight <= 0.0) return;
+  const Positions normals = closest_target_normals(x);
+  for (Eigen::Index v = 0; v < normals.rows(); ++v) {
+    const Eigen::Vector3d normal = normals.row(v).transpose();
+    if (normal.isZero()) continue;
     const Eigen::Matrix3d block = 2.0 * m_surface_weight * normal * normal.transpose();
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j)

@@ -12,6 +12,7 @@
 
 #include "design/balloon_design.hpp"
 #include "design/distance_energy.hpp"
+#include "design/objective_gauss_newton.hpp"
 #include "design/self_collision.hpp"
 #include "design/surface_distance.hpp"
 #include "fem/balloon_model.hpp"
@@ -44,6 +45,9 @@ class DesignObjective {
   /// k_surface times the growth set last (dimensionless).
   double surface_weight() const { return m_k_surface * m_surface_growth_now; }
 
+  /// Gauss-Newton Hessian of E_dist + E_surf at x, as an operator (the regularizers are left out).
+  ObjectiveGaussNewton gauss_newton(const Eigen::VectorXd& x) const;
+
   /// Gauss-Newton Hessian of E_surf, point-to-plane, as triplets shifted by dof_offset.
   void add_surface_hessian(const Eigen::VectorXd& x, std::vector<Eigen::Triplet<double>>& triplets,
                            int dof_offset) const;
@@ -71,6 +75,9 @@ class DesignObjective {
   bool rest_bending_active() const { return m_rest_bending_active; }
 
  private:
+  /// Per vertex of x, the unit normal of the target triangle closest to it (a zero row where that
+  /// triangle is degenerate).
+  Positions closest_target_normals(const Eigen::VectorXd& x) const;
   /// Hinges of `rest` whose dihedral angle moved more than a right angle from the start's.
   int inverted_hinges(const Eigen::VectorXd& rest) const;
 

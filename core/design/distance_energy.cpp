@@ -369,6 +369,8 @@ void DistanceEnergy::residual_jacobian_triplets(Eigen::Ref<const Eigen::VectorXd
                                                 std::vector<Eigen::Triplet<double>>& triplets,
                                                 int dof_offset) const {
   if (x.size() != 3 * m_vertex_count) throw std::invalid_argument("DistanceEnergy: x has the wrong size");
+  triplets.reserve(triplets.size() + (m_k_length > 0.0 ? 6 * static_cast<size_t>(edge_count()) : 0) +
+                   (m_k_bending > 0.0 ? 12 * static_cast<size_t>(m_hinge_count) : 0));
   int row = 0;
   if (m_k_length > 0.0) {
     for (int e = 0; e < edge_count(); ++e, ++row) {

@@ -5,7 +5,7 @@
 namespace balloon {
 
 GaussNewtonDirection reduced_gauss_newton_direction(
-    const AdjointSensitivity& sensitivity, const Eigen::SparseMatrix<double>& hessian_x,
+    const AdjointSensitivity& sensitivity, const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& hessian_x,
     const Eigen::VectorXd& gradient, const std::vector<bool>& rest_free, const Eigen::VectorXd& rest_volume_gradient,
     const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& precondition, int max_iterations, double tolerance) {
   Eigen::VectorXd w = rest_volume_gradient;
@@ -22,7 +22,7 @@ GaussNewtonDirection reduced_gauss_newton_direction(
     Eigen::VectorXd dx;
     double dp = 0.0;
     sensitivity.linear_response(d, dx, dp);  // J d
-    return project(sensitivity.gradient(hessian_x * dx));  // P J^T H J d
+    return project(sensitivity.gradient(hessian_x(dx)));  // P J^T H J d
   };
 
   GaussNewtonDirection out;

@@ -23,13 +23,13 @@ struct GaussNewtonDirection {
   bool descent = false;       ///< direction . gradient < 0
 };
 
-/// `sensitivity` prepared at the current equilibrium; `hessian_x` the objective's Gauss-Newton Hessian in
-/// inflated coordinates (positive semi-definite); `gradient` the projected design gradient (3#V);
+/// `sensitivity` prepared at the current equilibrium; `hessian_x` multiplies by the objective's
+/// Gauss-Newton Hessian in inflated coordinates (positive semi-definite); `gradient` the projected design gradient (3#V);
 /// `rest_free` the movable rest coordinates; `rest_volume_gradient` dV_rest/drest (3#V), projected out;
 /// `precondition` an approximate inverse of A (applied, then projected). CG stops at `max_iterations`,
 /// at a relative residual of `tolerance`, or at a direction of non-positive curvature.
 GaussNewtonDirection reduced_gauss_newton_direction(
-    const AdjointSensitivity& sensitivity, const Eigen::SparseMatrix<double>& hessian_x,
+    const AdjointSensitivity& sensitivity, const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& hessian_x,
     const Eigen::VectorXd& gradient, const std::vector<bool>& rest_free, const Eigen::VectorXd& rest_volume_gradient,
     const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& precondition, int max_iterations, double tolerance);
 

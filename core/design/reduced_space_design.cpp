@@ -315,11 +315,7 @@ class ReducedSpaceDesign {
   /// The Gauss-Newton direction at the current equilibrium (the sensitivity was prepared by the last
   /// objective_gradient): E_dist's and E_surf's Gauss-Newton Hessian in inflated coordinates, pulled back.
   GaussNewtonDirection gauss_newton_direction(const Eigen::VectorXd& rest, const Eigen::VectorXd& gradient) {
-    std::vector<Eigen::Triplet<double>> entries;
-    m_distance.hessian_triplets(m_x, entries, DistanceHessian::GaussNewton);
-    m_objective.add_surface_hessian(m_x, entries, 0);
-    Eigen::SparseMatrix<double> hessian(m_x.size(), m_x.size());
-    hessian.setFromTriplets(entries.begin(), entries.end());
+    const ObjectiveGaussNewton hessian = m_objective.gauss_newton(m_x);
     return reduced_gauss_newton_direction(
         m_sensitivity, hessian, gradient, m_rest_free, m_model.volume_gradient(rest),
         [this](const Eigen::VectorXd& q) { return m_lbfgs.precondition(q); }, GAUSS_NEWTON_CG_ITERATIONS,

@@ -79,3 +79,36 @@ TEST(DesignObjective, AGrowthBelowOneIsRefused) {
 
 }  // namespace
 }  // namespace balloon
+
+namespace balloon {
+namespace {
+
+TEST(DesignObjective, ItsGaussNewtonOperatorMultipliesLikeTheAssembledMatrix) {
+  TriMesh target = make_icosphere(10.0, 2);
+  target.vertices.col(0) *= 1.5;
+  const TriMesh start = make_icosphere(5.0, 2);
+  DesignOptions options;
+  options.material = *parse_material_spec("silicone");
+  const fem::BalloonModel model(start, options.material,
+                                std::vector<double>(static_cast<size_t>(start.face_count()), options.thickness_mm));
+  DesignObjective objective(target, start, options, model);
+  objective.grow_surface_weight(8);  // a weight other than the start's, so both terms count
+
+  Eigen::VectorXd x(3 * target.vertex_count()), v(3 * target.vertex_count());
+  for (int i = 0; i < target.vertex_count(); ++i) {
+    x.segment<3>(3 * i) = 1.05 * target.vertices.row(i).transpose() + Eigen::Vector3d(0.3 * std::sin(i), 0.2 * std::cos(3 * i), 0.0);
+    v.segment<3>(3 * i) = Eigen::Vector3d(std::cos(i), std::sin(2 * i), 0.5);
+  }
+  std::vector<Eigen::Triplet<double>> entries;
+  objective.distance().hessian_triplets(x, entries, DistanceHessian::GaussNewton);
+  objective.add_surface_hessian(x, entries, 0);
+  Eigen::SparseMatrix<double> assembled(x.size(), x.size());
+  assembled.setFromTriplets(entries.begin(), entries.end());
+  const Eigen::VectorXd expected = assembled * v;
+  const Eigen::VectorXd product = objective.gauss_newton(x)(v);
+  ASSERT_GT(expected.norm(), 0.0);
+  EXPECT_LE((product - expected).norm(), 1e-12 * expected.norm());
+}
+
+}  // namespace
+}  // namespace balloon
