@@ -117,8 +117,6 @@ void DesignObjective::add_regularizer_gradient(const Eigen::VectorXd& rest, Eige
   if (m_max_volume_weight > 0.0) gradient -= m_max_volume_weight * m_model.volume_gradient(rest);
 }
 
-/// Point-to-plane: 2 w n n^T per vertex with n the normal of the target triangle closest to it (sliding
-/// along the target costs nothing; E_dist governs that).
 Positions DesignObjective::closest_target_normals(const Eigen::VectorXd& x) const {
   const Positions points = unflatten(x);
   Positions closest;
@@ -145,6 +143,8 @@ ObjectiveGaussNewton DesignObjective::gauss_newton(const Eigen::VectorXd& x) con
                               m_surface_weight);
 }
 
+/// Point-to-plane: 2 w n n^T per vertex with n the normal of the target triangle closest to it (sliding
+/// along the target costs nothing; E_dist governs that).
 void DesignObjective::add_surface_hessian(const Eigen::VectorXd& x, std::vector<Eigen::Triplet<double>>& triplets,
                                           int dof_offset) const {
   if (m_surface_weight <= 0.0) return;
