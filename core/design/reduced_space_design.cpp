@@ -254,8 +254,8 @@ class ReducedSpaceDesign {
         // towards a stall goes on: a design whose error no growth moves is still stalled.
         objective = m_objective.value(rest, m_x);
         m_lbfgs.clear();
-        if (!objective_gradient(rest, gradient)) {
-          stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized");
+        if (!gradient_at_prepared(rest, gradient)) {
+          stop_with(result, DesignStop::Stalled, "stalled: the design gradient is not finite");
           break;
         }
         build_preconditioner();
@@ -298,6 +298,12 @@ class ReducedSpaceDesign {
   bool objective_gradient(const Eigen::VectorXd& rest, Eigen::VectorXd& gradient) {
     m_model.set_rest_positions(unflatten(rest));
     if (!m_sensitivity.prepare(rest, m_x, m_pressure)) return false;
+    return gradient_at_prepared(rest, gradient);
+  }
+
+  /// objective_gradient with the sensitivity already prepared at (rest, m_x, m_pressure): after the
+  /// objective itself changed there.
+  bool gradient_at_prepared(const Eigen::VectorXd& rest, Eigen::VectorXd& gradient) {
     gradient = m_sensitivity.gradient(m_objective.shape_gradient(m_x));
     m_objective.add_regularizer_gradient(rest, gradient);
     for (int c = 0; c < gradient.size(); ++c)
