@@ -49,7 +49,6 @@ DesignObjective::DesignObjective(const TriMesh& target, const TriMesh& start, co
   const double diag = m_surface.bbox_diagonal_mm();
   m_unit_surface_weight = m_distance.rest_lengths().sum() / (diag * diag * target.vertex_count());
   m_k_surface = options.k_surface;
-  m_surface_weight = m_k_surface * m_unit_surface_weight;
   m_surface_growth = options.surface_growth;
   m_max_surface_growth = options.max_surface_growth;
   m_surface_growth_iterations = options.surface_growth_iterations;
@@ -60,8 +59,7 @@ bool DesignObjective::grow_surface_weight(int iterations) {
                                  std::pow(m_surface_growth, std::max(0, iterations) / m_surface_growth_iterations));
   if (growth == m_surface_growth_now) return false;
   m_surface_growth_now = growth;
-  m_surface_weight = m_k_surface * growth * m_unit_surface_weight;
-  return m_surface_weight > 0.0;
+  return surface_weight_mm() > 0.0;
 }
 
 double DesignObjective::value(const Eigen::VectorXd& rest, const Eigen::VectorXd& x) const {
@@ -82,7 +80,7 @@ Eigen::VectorXd DesignObjective::shape_gradient(const Eigen::VectorXd& x) const 
 /// reference edge length, mm). Its gradient is 2 w (x_i - c_i) with c_i the closest target point
 /// (the derivative of a squared distance to a surface, wherever the closest point is unique).
 double DesignObjective::surface_term(const Eigen::VectorXd& x, Eigen::VectorXd* gradient) const {
-  if (m_surface_weight <= 0.0) {
+  if (surface_weight_mm() <= 0.0) {
     if (gradient) gradient->setZero(x.size());
     return 0.0;
   }
@@ -92,8 +90,8 @@ double DesignObjective::surface_term(const Eigen::VectorXd& x, Eigen::VectorXd* 
   Positions closest;
   Eigen::VectorXd distances;
   m_surface.closest_points(points, closest, &distances);
-  if (gradient) *gradient = 2.0 * m_surface_weight * flat(Positions(points - closest));
-  return m_surface_weight * distances.squaredNorm();
+  if (gradient) *gradient = 2.0 * surface_weight_mm() * flat(Positions(points - closest));
+  return surface_weight_mm() * distances.squaredNorm();
 }
 
 double DesignObjective::regularizer_value(const Eigen::VectorXd& rest) const {
@@ -139,20 +137,20 @@ ObjectiveGaussNewton DesignObjective::gauss_newton(const Eigen::VectorXd& x) con
   Eigen::SparseMatrix<double, Eigen::RowMajor> jacobian(m_distance.residual_count(), x.size());
   jacobian.setFromTriplets(entries.begin(), entries.end());
   return ObjectiveGaussNewton(std::move(jacobian),
-                              m_surface_weight > 0.0 ? closest_target_normals(x) : Positions::Zero(0, 3),
-                              m_surface_weight);
+                              surface_weight_mm() > 0.0 ? closest_target_normals(x) : Positions::Zero(0, 3),
+                              surface_weight_mm());
 }
 
 /// Point-to-plane: 2 w n n^T per vertex with n the normal of the target triangle closest to it (sliding
 /// along the target costs nothing; E_dist governs that).
 void DesignObjective::add_surface_hessian(const Eigen::VectorXd& x, std::vector<Eigen::Triplet<double>>& triplets,
                                           int dof_offset) const {
-  if (m_surface_weight <= 0.0) return;
+  if (surface_weight_mm() <= 0.0) return;
   const Positions normals = closest_target_normals(x);
   for (Eigen::Index v = 0; v < normals.rows(); ++v) {
     const Eigen::Vector3d normal = normals.row(v).transpose();
     if (normal.isZero()) continue;
-    const Eigen::Matrix3d block = 2.0 * m_surface_weight * normal * normal.transpose();
+    const Eigen::Matrix3d block = 2.0 * surface_weight_mm() * normal * normal.transpose();
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j)
         triplets.emplace_back(dof_offset + 3 * static_cast<int>(v) + i, dof_offset + 3 * static_cast<int>(v) + j,
@@ -191,7 +189,7 @@ int DesignObjective::inverted_hinges(const Eigen::VectorXd& rest) const {
 }
 
 bool DesignObjective::realign(Eigen::VectorXd& x) const {
-  if (m_surface_weight <= 0.0) return false;
+  if (surface_weight_mm() <= 0.0) return false;
   const Positions current = unflatten(x);
   const Positions aligned = rigid_align_to(current, m_target.vertices);
   if ((aligned - current).rowwise().norm().mean() <= REALIGN_TOLERANCE_REL * m_surface.bbox_diagonal_mm()) return false;
@@ -201,7 +199,7 @@ bool DesignObjective::realign(Eigen::VectorXd& x) const {
 
 void DesignObjective::list_common_terms(DesignResult& result, bool nozzle) const {
   result.active_terms.push_back("distance");
-  if (m_surface_weight > 0.0) result.active_terms.push_back("surface");
+  if (surface_weight_mm() > 0.0) result.active_terms.push_back("surface");
   if (nozzle) result.active_terms.push_back("nozzle");
   if (m_rest_bending_active) result.active_terms.push_back("rest_bending");
 }

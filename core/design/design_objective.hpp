@@ -78,6 +78,8 @@ class DesignObjective {
   /// Per vertex of x, the unit normal of the target triangle closest to it (a zero row where that
   /// triangle is degenerate).
   Positions closest_target_normals(const Eigen::VectorXd& x) const;
+  /// w of E_surf = w sum_i d_i^2 now (mm^-1); 0 when k_surface is 0.
+  double surface_weight_mm() const { return m_k_surface * m_surface_growth_now * m_unit_surface_weight; }
   /// Hinges of `rest` whose dihedral angle moved more than a right angle from the start's.
   int inverted_hinges(const Eigen::VectorXd& rest) const;
 
@@ -89,8 +91,7 @@ class DesignObjective {
   std::unique_ptr<SelfCollision> m_collision;
   bool m_collision_seen = false;
   bool m_rest_bending_active = false;
-  double m_surface_weight = 0.0;     ///< w of E_surf = w sum_i d_i^2 (mm^-1); 0 when k_surface is 0
-  double m_unit_surface_weight = 0.0;  ///< w for k_surface = 1 (mm^-1)
+  double m_unit_surface_weight = 0.0;  ///< w of E_surf = w sum_i d_i^2 for k_surface = 1 (mm^-1)
   double m_k_surface = 0.0;
   double m_surface_growth = 1.0, m_max_surface_growth = 1.0, m_surface_growth_now = 1.0;
   int m_surface_growth_iterations = 1;

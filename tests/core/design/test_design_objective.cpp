@@ -1,5 +1,6 @@
-// The design objective's surface term grows on its schedule (DesignOptions::surface_growth): by the
-// factor after every surface_growth_iterations iterations, up to its cap, and only the surface term moves.
+// The design objective: its surface term grows on its schedule (DesignOptions::surface_growth), by the
+// factor after every surface_growth_iterations iterations, up to its cap, and only that term moves; its
+// Gauss-Newton operator multiplies like the assembled matrix.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,18 +14,34 @@
 namespace balloon {
 namespace {
 
+/// A target (an icosphere stretched 1.5 times along x, 162 vertices), a start (a smaller sphere) and
+/// the objective between them.
+struct ObjectiveScene {
+  TriMesh target = stretched_sphere();
+  TriMesh start = make_icosphere(5.0, 2);
+  fem::BalloonModel model;
+  DesignObjective objective;
+
+  explicit ObjectiveScene(const DesignOptions& options)
+      : model(start, options.material,
+              std::vector<double>(static_cast<size_t>(start.face_count()), options.thickness_mm)),
+        objective(target, start, options, model) {}
+  static TriMesh stretched_sphere() {
+    TriMesh mesh = make_icosphere(10.0, 2);
+    mesh.vertices.col(0) *= 1.5;
+    return mesh;
+  }
+};
+
 TEST(DesignObjective, TheSurfaceWeightGrowsOnItsScheduleUpToItsCap) {
-  TriMesh target = make_icosphere(10.0, 2);
-  target.vertices.col(0) *= 1.5;
-  const TriMesh start = make_icosphere(5.0, 2);
   DesignOptions options;
   options.material = *parse_material_spec("silicone");
   options.surface_growth = 3.0;
   options.surface_growth_iterations = 8;
   options.max_surface_growth = 20.0;
-  const fem::BalloonModel model(start, options.material,
-                                std::vector<double>(static_cast<size_t>(start.face_count()), options.thickness_mm));
-  DesignObjective objective(target, start, options, model);
+  ObjectiveScene scene(options);
+  const TriMesh& target = scene.target;
+  DesignObjective& objective = scene.objective;
 
   // A shape off the target: both terms are non-zero.
   Eigen::VectorXd x(3 * target.vertex_count());
@@ -55,7 +72,7 @@ TEST(DesignObjective, TheSurfaceWeightGrowsOnItsScheduleUpToItsCap) {
   // The gradient follows the weight: shape_gradient = grad E_dist + 3 grad E_surf.
   Eigen::VectorXd distance_gradient, surface_gradient;
   objective.distance().gradient(x, distance_gradient);
-  DesignObjective unit(target, start, options, model);
+  DesignObjective unit(target, scene.start, options, scene.model);
   unit.surface_term(x, &surface_gradient);
   EXPECT_LE((objective.shape_gradient(x) - distance_gradient - 3.0 * surface_gradient).norm(),
             1e-12 * (distance_gradient.norm() + surface_gradient.norm()));
@@ -77,21 +94,12 @@ TEST(DesignObjective, AGrowthBelowOneIsRefused) {
   }
 }
 
-}  // namespace
-}  // namespace balloon
-
-namespace balloon {
-namespace {
-
 TEST(DesignObjective, ItsGaussNewtonOperatorMultipliesLikeTheAssembledMatrix) {
-  TriMesh target = make_icosphere(10.0, 2);
-  target.vertices.col(0) *= 1.5;
-  const TriMesh start = make_icosphere(5.0, 2);
   DesignOptions options;
   options.material = *parse_material_spec("silicone");
-  const fem::BalloonModel model(start, options.material,
-                                std::vector<double>(static_cast<size_t>(start.face_count()), options.thickness_mm));
-  DesignObjective objective(target, start, options, model);
+  ObjectiveScene scene(options);
+  const TriMesh& target = scene.target;
+  DesignObjective& objective = scene.objective;
   objective.grow_surface_weight(8);  // a weight other than the start's, so both terms count
 
   Eigen::VectorXd x(3 * target.vertex_count()), v(3 * target.vertex_count());
