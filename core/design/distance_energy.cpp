@@ -284,8 +284,7 @@ void DistanceEnergy::hessian_triplets(Eigen::Ref<const Eigen::VectorXd> x,
                                       std::vector<Eigen::Triplet<double>>& triplets, DistanceHessian kind,
                                       int dof_offset) const {
   if (x.size() != 3 * m_vertex_count) throw std::invalid_argument("DistanceEnergy: x has the wrong size");
-  triplets.reserve(triplets.size() + (m_k_length > 0.0 ? 36 * static_cast<size_t>(edge_count()) : 0) +
-                   (m_k_bending > 0.0 ? 144 * static_cast<size_t>(m_hinge_count) : 0));
+  triplets.reserve(triplets.size() + hessian_entry_count());
   if (m_k_length > 0.0) {
     for (int e = 0; e < edge_count(); ++e) {
       const int* v = &m_edges(e, 0);
@@ -330,6 +329,11 @@ void DistanceEnergy::hessian_triplets(Eigen::Ref<const Eigen::VectorXd> x,
       scatter<12>(local, v, dof_offset, triplets);
     }
   }
+}
+
+size_t DistanceEnergy::hessian_entry_count() const {
+  return (m_k_length > 0.0 ? 36 * static_cast<size_t>(edge_count()) : 0) +
+         (m_k_bending > 0.0 ? 144 * static_cast<size_t>(m_hinge_count) : 0);
 }
 
 Eigen::SparseMatrix<double> DistanceEnergy::hessian(Eigen::Ref<const Eigen::VectorXd> x,

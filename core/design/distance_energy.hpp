@@ -79,6 +79,8 @@ class DistanceEnergy {
   /// unknowns such as (rest, deformed) in the augmented Lagrangian). Duplicates are meant to be summed.
   void hessian_triplets(Eigen::Ref<const Eigen::VectorXd> x, std::vector<Eigen::Triplet<double>>& triplets,
                         DistanceHessian kind = DistanceHessian::Exact, int dof_offset = 0) const;
+  /// How many entries hessian_triplets appends (at most).
+  size_t hessian_entry_count() const;
   /// The Hessian as a 3#V by 3#V sparse matrix (convenience over hessian_triplets).
   Eigen::SparseMatrix<double> hessian(Eigen::Ref<const Eigen::VectorXd> x,
                                       DistanceHessian kind = DistanceHessian::Exact) const;

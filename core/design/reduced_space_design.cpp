@@ -335,8 +335,7 @@ class ReducedSpaceDesign {
     std::vector<Eigen::Triplet<double>> entries;
     // Room for both terms at once: about 2 million entries at 4,000 vertices, which the surface term's
     // few more doubled (a 70 MB copy beside the 35 MB one, the design's peak memory) when they did not fit.
-    entries.reserve(36 * static_cast<size_t>(m_distance.edge_count()) + 144 * static_cast<size_t>(m_distance.hinge_count()) +
-                    9 * static_cast<size_t>(m_x.size() / 3));
+    entries.reserve(m_distance.hessian_entry_count() + 9 * static_cast<size_t>(m_x.size() / 3));
     m_distance.hessian_triplets(m_x, entries, DistanceHessian::GaussNewton);
     m_objective.add_surface_hessian(m_x, entries, 0);
     Eigen::SparseMatrix<double> hessian(m_x.size(), m_x.size());
