@@ -5,6 +5,9 @@
 namespace balloon::store {
 namespace {
 
+/// Distinct SQL texts a connection keeps prepared.
+constexpr size_t MAX_CACHED_STATEMENTS = 128;
+
 [[noreturn]] void throw_error(sqlite3* db, const std::string& what) {
   throw DatabaseError(what + ": " + (db != nullptr ? sqlite3_errmsg(db) : "out of memory"));
 }
@@ -31,8 +34,9 @@ Database::Database(const std::string& path, int busy_timeout_ms, Synchronous syn
 }
 
 Database::~Database() {
-  // Every Statement has been finalized by now (they cannot outlive a Database in our code), so close
-  // succeeds; close_v2 would defer otherwise rather than leak.
+  // Every Statement is back in the cache or finalized by now (they cannot outlive a Database in our
+  // code), so close succeeds once the cache is emptied; close_v2 would defer otherwise rather than leak.
+  for (auto& [sql, statement] : m_idle_statements) sqlite3_finalize(statement);
   sqlite3_close_v2(m_db);
 }
 
@@ -47,10 +51,25 @@ void Database::execute(std::string_view sql) {
 }
 
 Statement Database::prepare(std::string_view sql) {
+  std::string key(sql);
+  if (const auto idle = m_idle_statements.find(key); idle != m_idle_statements.end()) {
+    sqlite3_stmt* statement = idle->second;
+    m_idle_statements.erase(idle);
+    return Statement(*this, statement, std::move(key));
+  }
   sqlite3_stmt* statement = nullptr;
-  if (sqlite3_prepare_v2(m_db, sql.data(), static_cast<int>(sql.size()), &statement, nullptr) != SQLITE_OK)
+  if (sqlite3_prepare_v3(m_db, sql.data(), static_cast<int>(sql.size()), SQLITE_PREPARE_PERSISTENT, &statement,
+                         nullptr) != SQLITE_OK)
     throw_error(m_db, "preparing '" + std::string(sql.substr(0, 60)) + "'");
-  return Statement(*this, statement);
+  // The store's SQL is a fixed set of texts; beyond this many distinct ones, something builds them.
+  if (m_idle_statements.size() >= MAX_CACHED_STATEMENTS) key.clear();
+  return Statement(*this, statement, std::move(key));
+}
+
+void Database::return_to_cache(std::string sql, sqlite3_stmt* statement) {
+  sqlite3_reset(statement);
+  sqlite3_clear_bindings(statement);
+  if (!m_idle_statements.emplace(std::move(sql), statement).second) sqlite3_finalize(statement);
 }
 
 void Database::interrupt() { sqlite3_interrupt(m_db); }
@@ -63,11 +82,23 @@ std::int64_t Database::last_insert_id() const { return sqlite3_last_insert_rowid
 int Database::changes() const { return sqlite3_changes(m_db); }
 
 Statement::Statement(Statement&& other) noexcept
-    : m_database(other.m_database), m_statement(other.m_statement) {
+    : m_database(other.m_database), m_statement(other.m_statement), m_cache_key(std::move(other.m_cache_key)) {
   other.m_statement = nullptr;
+  other.m_cache_key.clear();
 }
 
-Statement::~Statement() { sqlite3_finalize(m_statement); }
+Statement::~Statement() {
+  if (m_statement == nullptr) return;
+  if (m_cache_key.empty()) {
+    sqlite3_finalize(m_statement);
+    return;
+  }
+  try {
+    m_database->return_to_cache(std::move(m_cache_key), m_statement);
+  } catch (...) {
+    sqlite3_finalize(m_statement);  // out of memory for the cache entry: a destructor must not throw
+  }
+}
 
 Statement& Statement::bind(int index, std::int64_t value) {
   if (sqlite3_bind_int64(m_statement, index, value) != SQLITE_OK) throw_error(m_database->m_db, "bind");
@@ -135,19 +166,19 @@ bool Statement::column_is_null(int column) const {
   return sqlite3_column_type(m_statement, column) == SQLITE_NULL;
 }
 
-Transaction::Transaction(Database& database) : m_database(database) { m_database.execute("BEGIN IMMEDIATE"); }
+Transaction::Transaction(Database& database) : m_database(database) { m_database.prepare("BEGIN IMMEDIATE").run(); }
 
 Transaction::~Transaction() {
   if (m_done) return;
   try {
-    m_database.execute("ROLLBACK");
+    m_database.prepare("ROLLBACK").run();
   } catch (...) {
     // A failed rollback leaves SQLite to roll back on close; a destructor must not throw.
   }
 }
 
 void Transaction::commit() {
-  m_database.execute("COMMIT");
+  m_database.prepare("COMMIT").run();
   m_done = true;
 }
 
