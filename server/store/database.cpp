@@ -29,6 +29,9 @@ Database::Database(const std::string& path, int busy_timeout_ms, Synchronous syn
   if (path != ":memory:") execute("PRAGMA journal_mode = WAL");
   execute(synchronous == Synchronous::Full ? "PRAGMA synchronous = FULL; PRAGMA foreign_keys = ON"
                                            : "PRAGMA synchronous = NORMAL; PRAGMA foreign_keys = ON");
+  // A row that INSERT OR REPLACE replaces fires its delete triggers only with this on (the store's usage
+  // counts rely on them; see schema.cpp, version 6).
+  execute("PRAGMA recursive_triggers = ON");
   // Statement journals and sorts in memory: a result's multi-MB blobs must not be copied to /var/tmp.
   execute("PRAGMA temp_store = MEMORY");
 }

@@ -69,14 +69,8 @@ constexpr const char* DELETE_FINISHED_JOB =
 constexpr const char* DELETE_FINISHED_BEFORE =
     "DELETE FROM jobs WHERE state IN ('completed', 'failed', 'cancelled') AND finished_ms < ?";
 // length() of a BLOB reads its size, not its bytes.
-constexpr const char* SELECT_STORED_BYTES =
-    "SELECT (SELECT COALESCE(SUM(LENGTH(summary) + LENGTH(error)), 0) FROM jobs WHERE owner = ?) + "
-    "(SELECT COALESCE(SUM(LENGTH(s.spec)), 0) FROM job_specs AS s JOIN jobs AS j ON j.id = s.job_row WHERE j.owner = ?) + "
-    "(SELECT COALESCE(SUM(LENGTH(r.rest_mesh) + LENGTH(r.inflated_mesh) + LENGTH(CAST(r.report_json AS BLOB)) + "
-    "COALESCE(LENGTH(r.report), 0) + COALESCE(LENGTH(r.mold_mesh), 0)), 0) "
-    " FROM results AS r JOIN jobs AS j ON j.id = r.job_row WHERE j.owner = ?) + "
-    "(SELECT COALESCE(SUM(COALESCE(LENGTH(p.shape), 0) + 64), 0) "
-    " FROM progress AS p JOIN jobs AS j ON j.id = p.job_row WHERE j.owner = ?)";
+/// Kept by the schema's triggers (version 6); no row yet: nothing stored.
+constexpr const char* SELECT_STORED_BYTES = "SELECT bytes FROM tenant_usage WHERE owner = ?";
 constexpr const char* COUNT_PROGRESS = "SELECT COUNT(*) FROM progress WHERE job_row = ?";
 
 #undef JOB_COLUMNS
@@ -336,7 +330,7 @@ int JobStore::delete_finished_before(std::int64_t cutoff_ms) {
 std::int64_t JobStore::stored_bytes(const std::string& owner) {
   std::lock_guard lock(m_store.mutex());
   Statement statement = m_store.database().prepare(SELECT_STORED_BYTES);
-  statement.bind(1, owner).bind(2, owner).bind(3, owner).bind(4, owner);
+  statement.bind(1, owner);
   return statement.step() ? statement.column_int64(0) : 0;
 }
 

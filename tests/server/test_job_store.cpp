@@ -246,8 +246,74 @@ TEST(JobStore, AJobQueuedBeforeSpecsMovedToTheirOwnTableKeepsItsSpec) {
     EXPECT_EQ(found->state, JobState::Queued);
     EXPECT_EQ(jobs.spec(found->row_id), std::string("\x0A\x0B\x0C"));
     EXPECT_EQ(jobs.recover_unfinished(3).queued.size(), 1u);
+    EXPECT_EQ(jobs.stored_bytes("alice"), 3) << "the migration counts what was stored before it";
   }
   remove_store_files(path);
+}
+
+/// The bytes `owner` stores, summed over every row (what the usage triggers keep up to date).
+std::int64_t recounted_bytes(Database& database, const std::string& owner) {
+  Statement statement = database.prepare(
+      "SELECT (SELECT COALESCE(SUM(LENGTH(summary) + LENGTH(error)), 0) FROM jobs WHERE owner = ?1) + "
+      "(SELECT COALESCE(SUM(LENGTH(s.spec)), 0) FROM job_specs AS s JOIN jobs AS j ON j.id = s.job_row "
+      " WHERE j.owner = ?1) + "
+      "(SELECT COALESCE(SUM(LENGTH(r.rest_mesh) + LENGTH(r.inflated_mesh) + LENGTH(CAST(r.report_json AS BLOB)) + "
+      " COALESCE(LENGTH(r.report), 0) + COALESCE(LENGTH(r.mold_mesh), 0)), 0) "
+      " FROM results AS r JOIN jobs AS j ON j.id = r.job_row WHERE j.owner = ?1) + "
+      "(SELECT COALESCE(SUM(COALESCE(LENGTH(p.shape), 0) + 64), 0) "
+      " FROM progress AS p JOIN jobs AS j ON j.id = p.job_row WHERE j.owner = ?1)");
+  statement.bind(1, owner);
+  return statement.step() ? statement.column_int64(0) : -1;
+}
+
+TEST(JobStore, TheBytesATenantStoresFollowEveryWrite) {
+  Store store(":memory:");
+  JobStore jobs(store);
+  const auto expect_counted = [&](const char* after) {
+    for (const char* owner : {"alice", "bob"}) {
+      std::int64_t recounted = 0;
+      {
+        std::lock_guard lock(store.mutex());
+        recounted = recounted_bytes(store.database(), owner);
+      }
+      EXPECT_EQ(jobs.stored_bytes(owner), recounted) << owner << ", after " << after;
+    }
+  };
+  JobRecord a = queued_job(jobs, "j-a", "alice");
+  JobRecord b = queued_job(jobs, "j-b", "bob");
+  JobRecord c = queued_job(jobs, "j-c", "alice");
+  expect_counted("inserts");
+  ASSERT_TRUE(jobs.mark_running(a.row_id));
+  ProgressRecord row;
+  row.phase = "design";
+  jobs.append_progress(a.row_id, row, std::string(700, 's'));
+  jobs.append_progress_batch(a.row_id, {row, row}, std::string(300, 't'), 1);  // clears the older shape
+  expect_counted("progress");
+  ResultRecord result;
+  result.rest_mesh = std::string(5000, 'r');
+  result.inflated_mesh = std::string(4000, 'i');
+  result.report = std::string(300, 'p');
+  result.mold_mesh = std::string(2000, 'm');
+  ASSERT_TRUE(jobs.mark_completed(a.row_id, result));
+  jobs.mark_failed(b.row_id, "the start could not be inflated");
+  ASSERT_TRUE(jobs.mark_cancelled(c.row_id, "cancelled by its owner"));
+  expect_counted("results, failures and cancellations");
+  {
+    // The store writes a result with INSERT OR REPLACE: a replaced one must leave the count too.
+    std::lock_guard lock(store.mutex());
+    store.database()
+        .prepare("INSERT OR REPLACE INTO results (job_row, converged, rest_mesh, inflated_mesh, report_json, "
+                 "created_ms) VALUES (?, 1, X'00', X'0000', '{}', 0)")
+        .bind(1, a.row_id)
+        .run();
+  }
+  expect_counted("a replaced result");
+  EXPECT_TRUE(jobs.delete_finished(a.row_id));
+  expect_counted("a deletion");
+  EXPECT_EQ(jobs.delete_finished_before(now_ms() + 1), 2);
+  expect_counted("the retention sweep");
+  EXPECT_EQ(jobs.stored_bytes("alice"), 0);
+  EXPECT_EQ(jobs.stored_bytes("bob"), 0);
 }
 
 }  // namespace
