@@ -21,9 +21,12 @@ constexpr const char* SELECT_SPEC = "SELECT spec FROM job_specs WHERE job_row = 
 
 constexpr const char* SELECT_JOB_BY_ID = "SELECT " JOB_COLUMNS JOB_FROM "WHERE jobs.job_id = ?";
 constexpr const char* SELECT_JOB_BY_ROW = "SELECT " JOB_COLUMNS JOB_FROM "WHERE jobs.id = ?";
+// `request_id <> ''` lets SQLite use the partial index jobs_request (its WHERE must follow from the query's):
+// without it, a new request id (every submission's) walked all the owner's jobs (20,000: 17 ms -> 0.01 ms).
 constexpr const char* SELECT_JOB_BY_REQUEST =
     "SELECT " JOB_COLUMNS JOB_FROM
-    "WHERE jobs.owner = ? AND jobs.request_id = ? AND jobs.created_ms >= ? ORDER BY jobs.id DESC LIMIT 1";
+    "WHERE jobs.owner = ? AND jobs.request_id = ? AND jobs.request_id <> '' AND jobs.created_ms >= ? "
+    "ORDER BY jobs.id DESC LIMIT 1";
 constexpr const char* SELECT_JOBS_PAGE =
     "SELECT " JOB_COLUMNS JOB_FROM
     "WHERE jobs.owner = ? AND jobs.id < ? AND (? = '' OR jobs.state = ?) ORDER BY jobs.id DESC LIMIT ?";
