@@ -71,7 +71,6 @@ constexpr const char* DELETE_FINISHED_JOB =
     "DELETE FROM jobs WHERE id = ? AND state IN ('completed', 'failed', 'cancelled')";
 constexpr const char* DELETE_FINISHED_BEFORE =
     "DELETE FROM jobs WHERE state IN ('completed', 'failed', 'cancelled') AND finished_ms < ?";
-// length() of a BLOB reads its size, not its bytes.
 /// Kept by the schema's triggers (version 6); no row yet: nothing stored.
 constexpr const char* SELECT_STORED_BYTES = "SELECT bytes FROM tenant_usage WHERE owner = ?";
 constexpr const char* COUNT_PROGRESS = "SELECT COUNT(*) FROM progress WHERE job_row = ?";

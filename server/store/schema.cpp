@@ -105,7 +105,8 @@ ALTER TABLE jobs DROP COLUMN spec;
 // SubmitJob. Summed over the tenant's rows at each submit it took 13 ms under the store's lock with 1,000
 // finished jobs stored, and grew with the history. A job's rows go in its own BEFORE DELETE trigger, while
 // the job still names their owner (a cascade would delete them after it). REPLACE deletes fire triggers
-// because the connection turns recursive_triggers on (Database).
+// because the connection turns recursive_triggers on (Database). length() of a BLOB reads its size, not
+// its bytes.
 constexpr const char* MIGRATION_6 = R"sql(
 CREATE TABLE tenant_usage (
   owner TEXT PRIMARY KEY,
