@@ -494,7 +494,10 @@ class InflationRun {
     double step = 0.5 * rest_volume;
     // The highest pressure on the path so far, and where; past a maximum below the target the path goes
     // on, for the pressure may climb again (a lobe that popped, a stiffening rubber's third branch).
+    // `snapped_from`: the highest pressure before the latest fall, where a balloon held at the target
+    // pressure snaps (the path's last step, past the target, is no maximum it passed).
     PathPoint peak = state;
+    PathPoint snapped_from = state;
     bool past_peak = false;
     NewtonReport report;
     while (state.pressure < target_pressure) {
@@ -502,7 +505,7 @@ class InflationRun {
       if (!volume_step(state, state.volume + step, report)) {
         if (report.stop != NewtonStop::Cancelled && stopped_passing_through_itself(state, message)) {
           if (past_peak)
-            message += "; before that " + fall_after(peak) + ", below the " + format_kpa(target_pressure) + " asked for";
+            message += "; before that " + fall_after(snapped_from) + ", below the " + format_kpa(target_pressure) + " asked for";
           return false;
         }
         if (stopped(report)) {
@@ -520,7 +523,10 @@ class InflationRun {
         continue;
       }
       if (state.pressure > peak.pressure) peak = state;
-      past_peak = past_peak || state.pressure < previous.pressure;
+      if (state.pressure < previous.pressure) {
+        past_peak = true;
+        snapped_from = peak;
+      }
       if (state.pressure < target_pressure && past_peak && state.volume > MAX_VOLUME_RATIO_PAST_A_PEAK * rest_volume)
         return above_maximum_pressure(state, peak, target_pressure, message);
       if (state.pressure < target_pressure && state.volume > 1e6 * rest_volume) {
@@ -530,7 +536,7 @@ class InflationRun {
       if (state.pressure >= target_pressure) {
         if (!settle_at_pressure(state, previous, state, target_pressure, message)) return false;
         if (past_peak)
-          m_final_message += "; on the way " + fall_after(peak) +
+          m_final_message += "; on the way " + fall_after(snapped_from) +
                              ": at that pressure the balloon snaps to a larger shape, and this is the one it reaches";
         return true;
       }
