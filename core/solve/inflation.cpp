@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -494,18 +495,17 @@ class InflationRun {
     double step = 0.5 * rest_volume;
     // The highest pressure on the path so far, and where; past a maximum below the target the path goes
     // on, for the pressure may climb again (a lobe that popped, a stiffening rubber's third branch).
-    // `snapped_from`: the highest pressure before the latest fall, where a balloon held at the target
-    // pressure snaps (the path's last step, past the target, is no maximum it passed).
+    // `snapped_from`: once the pressure fell, the highest pressure before the latest fall, where a balloon
+    // held at the target pressure snaps (the path's last step, past the target, is no maximum it passed).
     PathPoint peak = state;
-    PathPoint snapped_from = state;
-    bool past_peak = false;
+    std::optional<PathPoint> snapped_from;
     NewtonReport report;
     while (state.pressure < target_pressure) {
       PathPoint previous = state;
       if (!volume_step(state, state.volume + step, report)) {
         if (report.stop != NewtonStop::Cancelled && stopped_passing_through_itself(state, message)) {
-          if (past_peak)
-            message += "; before that " + fall_after(snapped_from) + ", below the " + format_kpa(target_pressure) + " asked for";
+          if (snapped_from)
+            message += "; before that " + fall_after(*snapped_from) + ", below the " + format_kpa(target_pressure) + " asked for";
           return false;
         }
         if (stopped(report)) {
@@ -516,18 +516,15 @@ class InflationRun {
         step *= 0.5;
         if (step < 1e-5 * rest_volume) {
           // Past a peak, a path that ends leaves the peak the highest pressure this balloon holds.
-          if (past_peak) return above_maximum_pressure(state, peak, target_pressure, message);
+          if (snapped_from) return above_maximum_pressure(state, peak, target_pressure, message);
           message = "no equilibrium found on the way to " + format_kpa(target_pressure) + " (" + report.message + ")";
           return false;
         }
         continue;
       }
       if (state.pressure > peak.pressure) peak = state;
-      if (state.pressure < previous.pressure) {
-        past_peak = true;
-        snapped_from = peak;
-      }
-      if (state.pressure < target_pressure && past_peak && state.volume > MAX_VOLUME_RATIO_PAST_A_PEAK * rest_volume)
+      if (state.pressure < previous.pressure) snapped_from = peak;
+      if (state.pressure < target_pressure && snapped_from && state.volume > MAX_VOLUME_RATIO_PAST_A_PEAK * rest_volume)
         return above_maximum_pressure(state, peak, target_pressure, message);
       if (state.pressure < target_pressure && state.volume > 1e6 * rest_volume) {
         message = "no equilibrium below volume ratio 1e6 for " + format_kpa(target_pressure);
@@ -535,8 +532,8 @@ class InflationRun {
       }
       if (state.pressure >= target_pressure) {
         if (!settle_at_pressure(state, previous, state, target_pressure, message)) return false;
-        if (past_peak)
-          m_final_message += "; on the way " + fall_after(snapped_from) +
+        if (snapped_from)
+          m_final_message += "; on the way " + fall_after(*snapped_from) +
                              ": at that pressure the balloon snaps to a larger shape, and this is the one it reaches";
         return true;
       }
