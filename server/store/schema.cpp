@@ -167,9 +167,15 @@ CREATE TRIGGER usage_progress_delete AFTER DELETE ON progress BEGIN
 END;
 )sql";
 
+// Version 7: a listing of one state (`balloon jobs list --state running`) reads that state's rows only;
+// through jobs_owner_id it walked every job the owner has.
+constexpr const char* MIGRATION_7 = R"sql(
+CREATE INDEX jobs_owner_state ON jobs (owner, state, id);
+)sql";
+
 const std::vector<const char*>& migrations() {
-  static const std::vector<const char*> list = {MIGRATION_1, MIGRATION_2, MIGRATION_3,
-                                                MIGRATION_4, MIGRATION_5, MIGRATION_6};
+  static const std::vector<const char*> list = {MIGRATION_1, MIGRATION_2, MIGRATION_3, MIGRATION_4,
+                                                MIGRATION_5, MIGRATION_6, MIGRATION_7};
   return list;
 }
 

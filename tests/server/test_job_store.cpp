@@ -1,5 +1,5 @@
-// Unit tests of the job store's lifecycle queries: recovery by the attempts rule, request ids, deletion
-// and the bytes a tenant stores, progress batches, and a command's store reopened from its WAL. A private
+// Unit tests of the job store's lifecycle queries: recovery by the attempts rule, request ids, listings by
+// state, deletion and the bytes a tenant stores, progress batches, and a command's store reopened from its WAL. A private
 // ":memory:" store each, except the reopened one (a temporary file).
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -264,6 +264,44 @@ std::int64_t recounted_bytes(Database& database, const std::string& owner) {
       " FROM progress AS p JOIN jobs AS j ON j.id = p.job_row WHERE j.owner = ?1)");
   statement.bind(1, owner);
   return statement.step() ? statement.column_int64(0) : -1;
+}
+
+TEST(JobStore, AListingOfOneStatePagesThroughThatStateOfTheOwnerOnly) {
+  Store store(":memory:");
+  JobStore jobs(store);
+  // alice: jobs 0..9, every third one running; bob: one running job between them.
+  std::vector<std::int64_t> alice_running;
+  for (int n = 0; n < 10; ++n) {
+    const JobRecord job = queued_job(jobs, "j-a" + std::to_string(n), "alice");
+    if (n % 3 == 0) {
+      ASSERT_TRUE(jobs.mark_running(job.row_id));
+      alice_running.push_back(job.row_id);
+    }
+    if (n == 4) {
+      ASSERT_TRUE(jobs.mark_running(queued_job(jobs, "j-b", "bob").row_id));
+    }
+  }
+  std::reverse(alice_running.begin(), alice_running.end());  // newest first
+
+  std::vector<std::int64_t> listed;
+  std::int64_t before = 0;
+  for (int page = 0; page < 10; ++page) {
+    const JobPage running = jobs.list("alice", JobState::Running, before, 3);
+    for (const JobRecord& job : running.jobs) {
+      EXPECT_EQ(job.owner, "alice");
+      EXPECT_EQ(job.state, JobState::Running);
+      listed.push_back(job.row_id);
+    }
+    before = running.next_before_row;
+    if (before == 0) break;
+  }
+  EXPECT_EQ(listed, alice_running);
+
+  const JobPage queued = jobs.list("alice", JobState::Queued, 0, 100);
+  EXPECT_EQ(queued.jobs.size(), 6u);
+  EXPECT_EQ(queued.next_before_row, 0);
+  EXPECT_EQ(jobs.list("alice", std::nullopt, 0, 100).jobs.size(), 10u);
+  EXPECT_TRUE(jobs.list("bob", JobState::Queued, 0, 100).jobs.empty());
 }
 
 TEST(JobStore, TheBytesATenantStoresFollowEveryWrite) {
