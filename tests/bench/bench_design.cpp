@@ -235,13 +235,16 @@ int main(int argc, char** argv) {
         const auto shown = [](const std::optional<double>& value) {
           return value.value_or(std::numeric_limits<double>::quiet_NaN());
         };
-        std::printf("%-22s %-9s %-8s %8d %9.2f %6d %11.4g %11.4g %9.3f %12.4g %12.4g %8.1fx %8.1f %10.2f  %s: %s\n",
+        // The stop word, then the message unless that already starts with it ("stalled: the surface ...").
+        const std::string stop_word = balloon::design_stop_name(r.stop);
+        const std::string status =
+            r.message.rfind(stop_word + ":", 0) == 0 ? r.message : stop_word + ": " + r.message;
+        std::printf("%-22s %-9s %-8s %8d %9.2f %6d %11.4g %11.4g %9.3f %12.4g %12.4g %8.1fx %8.1f %10.2f  %s\n",
                     shape.name.c_str(), material_label.c_str(), method_name.c_str(), r.rest.vertex_count(), r.time_s,
                     r.iterations, shown(r.avg_error_mm), shown(r.max_error_mm), 100.0 * shown(r.avg_error_rel),
                     shown(r.baseline_avg_error_mm), shown(r.baseline_max_error_mm),
                     shown(r.baseline_avg_error_mm) / shown(r.avg_error_mm), peak_mb,
-                    1000.0 * peak_mb / r.rest.vertex_count(), balloon::design_stop_name(r.stop).c_str(),
-                    r.message.c_str());
+                    1000.0 * peak_mb / r.rest.vertex_count(), status.c_str());
         if (std::find(r.active_terms.begin(), r.active_terms.end(), "sheet_bending") != r.active_terms.end())
           std::printf("%-22s   the sheet's bending was on (the membrane alone wrinkled with no stable state)\n", "");
         if (r.coarse_stage)
