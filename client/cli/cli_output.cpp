@@ -70,4 +70,10 @@ std::string message_to_json(const google::protobuf::Message& message) {
   return json;
 }
 
+std::string format(const char* pattern, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), pattern, value);
+  return buffer;
+}
+
 }  // namespace balloon::cli

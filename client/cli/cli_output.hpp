@@ -24,6 +24,9 @@ Result<bool> write_mesh_file(const TriMesh& mesh, const std::string& path);
 /// Writes `bytes` to `path` through a temporary file and a rename (no partial file on failure).
 Result<bool> write_file_atomically(const std::string& path, const std::string& bytes);
 
+/// One number through a printf pattern ("%.3f"): how the summaries print measured values.
+std::string format(const char* pattern, double value);
+
 /// A message as one line of protobuf JSON (proto field names, defaults printed): what --json prints.
 std::string message_to_json(const google::protobuf::Message& message);
 

@@ -157,12 +157,6 @@ Result<v1::SubmitJobRequest> design_request_from_args(const ParsedArgs& args) {
   return request;
 }
 
-std::string format(const char* pattern, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), pattern, value);
-  return buffer;
-}
-
 /// A report number formatted with `pattern`, or "n/a" when the report has none (never computed).
 std::string shown_number(bool has, double value, const char* pattern, double scale = 1.0) {
   return has ? format(pattern, scale * value) : "n/a";

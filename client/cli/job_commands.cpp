@@ -75,7 +75,7 @@ void print_job(const v1::Job& job) {
   if (job.state() == v1::JOB_STATE_QUEUED) std::cout << "  queue position " << job.queue_position() << "\n";
   if (job.has_last_progress()) {
     const auto& p = job.last_progress();
-    std::cout << "  progress: " << p.phase() << " " << p.iteration() << ", " << p.elapsed_s() << " s, p=" << p.pressure_kpa()
+    std::cout << "  progress: " << p.phase() << " " << p.iteration() << ", " << format("%.2f", p.elapsed_s()) << " s, p=" << p.pressure_kpa()
               << " kPa, residual " << p.residual_norm() << " N\n";
   }
   if (!job.error().empty()) std::cout << "  " << job.error() << "\n";

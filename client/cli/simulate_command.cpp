@@ -73,12 +73,6 @@ constexpr const char* HELP =
     "5 server unreachable or busy, 6 not allowed, 8 the job failed, 130 interrupted (the job keeps\n"
     "running), 1 internal error.\n\n";
 
-std::string format(const char* pattern, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), pattern, value);
-  return buffer;
-}
-
 /// What the model added beyond the membrane, for both summaries: the sheet's bending and flipped cap slivers.
 void append_model_notes(std::ostringstream& out, bool bending, int flipped_cap_slivers) {
   if (bending)

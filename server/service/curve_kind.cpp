@@ -52,7 +52,7 @@ class CurveKind final : public JobKind {
     result.report = curve_report(input, curve).SerializeAsString();
     const int reached = curve.last_converged_point + 1;
     std::string message = curve.converged ? "completed: " + std::to_string(curve.points.size()) + " points in " +
-                                                format_number(curve.time_s) + " s"
+                                                format_seconds(curve.time_s) + " s"
                                           : "completed with " + std::to_string(reached) + " of " +
                                                 std::to_string(curve.points.size()) + " points: " + curve.message;
     return RunOutcome::completed(std::move(result), std::move(message));

@@ -174,7 +174,7 @@ class DesignKind final : public JobKind {
     if (outcome.mold_mesh) result.mold_mesh = store::encode_mesh_blob(*outcome.mold_mesh);
     const std::string errors = jobs::design_error_summary(outcome.result);
     std::string message = (outcome.result.converged ? "completed: converged in " : "completed without converging in ") +
-                          format_number(outcome.result.time_s) + " s, " + errors +
+                          format_seconds(outcome.result.time_s) + " s, " + errors +
                           (outcome.result.converged ? std::string() : ": " + outcome.result.message);
     return RunOutcome::completed(std::move(result), std::move(message));
   }

@@ -102,7 +102,7 @@ class FitMaterialKind final : public JobKind {
     for (const FitResult& fit : outcome->fits) result.converged = result.converged && fit.converged;
     result.report = fit_report(*input, *outcome).SerializeAsString();
     std::string message = "completed: best fit " + material_spec(best.material) + " in " +
-                          format_number(outcome->time_s) + " s" + stored_note;
+                          format_seconds(outcome->time_s) + " s" + stored_note;
     return RunOutcome::completed(std::move(result), std::move(message));
   }
 

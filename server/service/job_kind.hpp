@@ -102,6 +102,8 @@ ServiceStatus read_uploaded_mesh(const balloon::v1::MeshFile& file, const std::s
 ServiceStatus bad_fields(const std::vector<jobs::FieldProblem>& problems);
 /// "%g" of a number.
 std::string format_number(double value);
+/// A measured duration as people read it: 0.0123 -> "0.01", 5.76272 -> "5.76", 123.456 -> "123.5" (s).
+std::string format_seconds(double seconds);
 /// True when `reference` names a tenant's stored material (not a preset, not an inline SPEC): the job
 /// then stores the SPEC as resolved at submit, so editing the material later does not change it.
 bool names_stored_material(const balloon::v1::MaterialRef& reference);

@@ -153,6 +153,12 @@ std::string format_number(double value) {
   return buffer;
 }
 
+std::string format_seconds(double seconds) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), seconds < 100.0 ? "%.2f" : "%.1f", seconds);
+  return buffer;
+}
+
 bool names_stored_material(const v1::MaterialRef& reference) {
   if (reference.kind_case() != v1::MaterialRef::kName) return false;
   const std::vector<std::string> presets = preset_names();

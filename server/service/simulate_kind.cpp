@@ -112,7 +112,7 @@ class SimulateKind final : public JobKind {
     result.inflated_mesh = store::encode_mesh_blob(TriMesh{outcome.result.deformed, input.rest.faces});
     result.report = simulate_report(input, outcome.result).SerializeAsString();
     std::string message = outcome.result.converged
-                              ? "completed: converged in " + format_number(outcome.result.time_s) + " s"
+                              ? "completed: converged in " + format_seconds(outcome.result.time_s) + " s"
                               : "completed without converging: " + outcome.result.message;
     return RunOutcome::completed(std::move(result), std::move(message));
   }
