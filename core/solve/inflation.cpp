@@ -323,10 +323,18 @@ class InflationRun {
     return true;
   }
 
-  /// An attempt that ran out of iterations while still halving its residual (a slow creep, as when a
-  /// local dimple pops through at a nearly constant pressure) is worth continuing where it ended:
+  /// An attempt from `from` that ran out of iterations while still halving its residual (a slow creep, as
+  /// when a local dimple pops through at a nearly constant pressure) is worth continuing where it ended:
   /// a smaller volume step would not help, since the pressure barely changes along such a path.
-  bool worth_resuming(const NewtonReport& report) const {
+  ///
+  /// Not a membrane's from the stress-free rest shape: with no out-of-plane stiffness to guide a far step,
+  /// its creep there is not such a path, and a much shorter step converges in a fraction of the steps
+  /// (inflate_to_volume cuts it to a quarter). The knot (200 mm, silicone x8): the step to 8 crept through
+  /// four resumes (240 Newton steps), the halved ones to 4.5, 2.75 and 1.88 through 60-160 each, and the
+  /// one to 1.44 converged in 13. The bent sheet keeps its resumes: the knot's bent step from rest to 8
+  /// converged after two (132 steps) where its shorter steps crept.
+  bool worth_resuming(const NewtonReport& report, const PathPoint& from) const {
+    if (stress_free(from) && !m_model.bending()) return false;
     return report.stop == NewtonStop::IterationLimit && std::isfinite(report.residual_norm) &&
            report.residual_norm < 0.5 * m_unfinished_start_residual;
   }
@@ -367,15 +375,7 @@ class InflationRun {
         continue;
       }
       if (report.stop != NewtonStop::Cancelled && stopped_passing_through_itself(state, message)) return false;
-      // From the stress-free rest shape a membrane has no out-of-plane stiffness to guide a far step: its
-      // creep there is not a dimple popping through at a constant pressure (what resumes are for), and a
-      // much shorter step converges in a fraction of the steps. The knot (200 mm, silicone x8): the step
-      // to 8 crept through four resumes (240 Newton steps), the halved ones to 4.5, 2.75 and 1.88 through
-      // 60-160 each, and the one to 1.44 converged in 13. The bent sheet keeps its resumes: the knot's
-      // bent step from rest to 8 converged after two (132 steps) where its shorter steps crept.
-      const bool from_stress_free = stress_free(state);
-      const bool resumable = !(from_stress_free && !m_model.bending());
-      while (resumable && !stopped(report) && worth_resuming(report) && resumes_left > 0) {
+      while (!stopped(report) && worth_resuming(report, state) && resumes_left > 0) {
         --resumes_left;
         const PathPoint unfinished = m_unfinished;
         if (volume_step(state, next, report, &unfinished)) break;
@@ -392,7 +392,7 @@ class InflationRun {
         from_bent_try = m_bent_try_unfinished.x.size() > 0 && m_bent_try_unfinished.volume == next;
         continue;
       }
-      step *= from_stress_free ? 0.25 : 0.5;  // see above
+      step *= stress_free(state) ? 0.25 : 0.5;  // see worth_resuming()
       if (std::abs(step) < smallest) {
         message = "no equilibrium found at volume ratio " + format_number(next / m_rest_volume) +
                   " (" + report.message + ", residual " + format_number(report.residual_norm) + " N against a tolerance of " +
@@ -473,7 +473,7 @@ class InflationRun {
       report = bent;
       return false;
     }
-    if (worth_resuming(bent)) m_bent_try_unfinished = m_unfinished;
+    if (worth_resuming(bent, state)) m_bent_try_unfinished = m_unfinished;
     set_bending(false);
     m_unfinished = membrane_unfinished;
     m_unfinished_start_residual = membrane_start_residual;
