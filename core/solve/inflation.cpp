@@ -392,7 +392,7 @@ class InflationRun {
         from_bent_try = m_bent_try_unfinished.x.size() > 0 && m_bent_try_unfinished.volume == next;
         continue;
       }
-      step *= stress_free(state) ? 0.25 : 0.5;  // see worth_resuming()
+      step *= stress_free(state) ? 0.25 : 0.5;  // from rest, membrane or bent: see worth_resuming()
       if (std::abs(step) < smallest) {
         message = "no equilibrium found at volume ratio " + format_number(next / m_rest_volume) +
                   " (" + report.message + ", residual " + format_number(report.residual_norm) + " N against a tolerance of " +
