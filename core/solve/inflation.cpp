@@ -388,9 +388,10 @@ class InflationRun {
       }
       if (creeping_through_wrinkles(report) && switch_bending_on()) {
         // The same step, now with a stable state: from where the early bent try of this very step ended,
-        // rather than repeating it from the predictor.
+        // rather than repeating it from the predictor. Where that try failed for good, the same attempt
+        // would fail the same way (it is deterministic), so the step is cut at once.
         from_bent_try = m_bent_try_unfinished.x.size() > 0 && m_bent_try_unfinished.volume == next;
-        continue;
+        if (from_bent_try || !bent_try_failed_for_good(state, next)) continue;
       }
       step *= stress_free(state) ? 0.25 : 0.5;  // from rest, membrane or bent: see worth_resuming()
       if (std::abs(step) < smallest) {
@@ -474,10 +475,16 @@ class InflationRun {
       return false;
     }
     if (worth_resuming(bent, state)) m_bent_try_unfinished = m_unfinished;
+    else m_bent_try_failed = {state.volume, next_volume};
     set_bending(false);
     m_unfinished = membrane_unfinished;
     m_unfinished_start_residual = membrane_start_residual;
     return false;
+  }
+
+  /// The early bent try was the step from `state` to `next_volume` and failed without being worth resuming.
+  bool bent_try_failed_for_good(const PathPoint& state, double next_volume) const {
+    return m_bent_try_failed.from_volume == state.volume && m_bent_try_failed.to_volume == next_volume;
   }
 
   /// A path that struggles has often pushed its walls through each other (the knot's tube near x3.5):
@@ -692,6 +699,9 @@ class InflationRun {
   int m_unstable_modes = 0;
   bool m_tried_bending_early = false;  ///< see try_bending_early
   PathPoint m_bent_try_unfinished;     ///< where that try ended, when it was still converging; else empty
+  struct {
+    double from_volume = -1.0, to_volume = -1.0;  ///< mm^3
+  } m_bent_try_failed;  ///< that try's step, when it failed and was not worth resuming
   std::string m_final_message = "converged";  ///< the last equilibrium solve's (it may name a rounding floor)
   PathPoint m_unfinished;                   ///< where the last failed attempt ended
   double m_unfinished_start_residual = 0.0;  ///< N, the residual that attempt started from
