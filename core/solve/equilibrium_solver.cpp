@@ -14,6 +14,9 @@
 namespace balloon {
 
 namespace {
+/// An SQP step along a direction softer than its model is tried at up to 2^MAX_STEP_DOUBLINGS times its
+/// length (constrained_descent).
+constexpr int MAX_STEP_DOUBLINGS = 5;
 /// A residual up to this multiple of its measured rounding level is rounding (the measure is the
 /// difference of two evaluations' errors, so it scatters about them by a factor of about 2).
 constexpr double ROUNDING_MARGIN = 3.0;
@@ -479,14 +482,33 @@ int EquilibriumSolver::constrained_descent(Eigen::VectorXd& x, double& pressure_
     return std::isfinite(norm) ? norm : std::numeric_limits<double>::infinity();
   };
   const double kkt0 = std::hypot(r.norm(), c * std::sqrt(kappa) * std::sqrt(base));
+  // A full unshifted SQP step that lowered the merit by more than its quadratic model predicts (half the
+  // slope) went along a direction softer than the model, whose membrane blocks are made positive
+  // definite: an unstable direction they hide. There the step is doubled while the merit keeps falling.
+  // (The anchor at 100 mm, Mooney-Rivlin x2: its walls slid towards each other through 90 full steps
+  // with the residual creeping up from 1e-4 N, 237 Newton steps in all; lengthened, 80.) A shifted model
+  // was made stiff on purpose and is taken as it is.
+  auto lengthened = [&](double full_step_merit) {
+    double best = full_step_merit, length = 1.0;
+    for (int doubling = 0; doubling < MAX_STEP_DOUBLINGS; ++doubling) {
+      const double longer = merit(x + 2.0 * length * step);
+      if (!(std::isfinite(longer) && longer < best)) break;
+      best = longer;
+      length *= 2.0;
+    }
+    return length;
+  };
   double t = 1.0;
   for (int k = 0; k < 30; ++k, t *= 0.5) {
     const Eigen::VectorXd trial = x + t * step;
     const double trial_value = merit(trial);
     if ((std::isfinite(trial_value) && trial_value <= value + 1e-4 * t * std::min(0.0, slope)) ||
         kkt_residual(trial, pressure_mpa + t * dp) < 0.5 * kkt0) {
-      x = trial;
-      pressure_mpa = pressure_mpa + t * dp;
+      const bool softer_than_modelled =
+          k == 0 && !exact_model && m_sqp_shift == 0.0 && slope < 0.0 && value - trial_value > 0.75 * -slope;
+      const double length = softer_than_modelled ? lengthened(trial_value) : t;
+      x += length * step;
+      pressure_mpa += length * dp;
       return k;
     }
     if (k == 0 && floating) {

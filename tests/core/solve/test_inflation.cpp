@@ -557,8 +557,21 @@ TEST(Inflation, AMembraneEquilibriumThatPassesThroughItselfIsTriedAgainWithBendi
 TEST(Inflation, AFailedEarlyBentTryIsNotRepeatedOnceBendingGoesOn) {
   // The anchor at 10 mm with Neo-Hookean rubber to ratio 8: its first step from rest creeps as a membrane,
   // its early bent try diverges (60 Newton steps), and once bending went on for good the same attempt ran
-  // again, step for step the same 60: 217 in all. Now the step is cut at once: 158.
+  // again, step for step the same 60: 217 in all. Now the step is cut at once: 158 (125 with the
+  // lengthened SQP steps below).
   expect_converges_within(inflate_corpus_mesh("anchor_dense.off", 10.0, "neo-hookean:mu=0.3", 8.0), 8.0, 190);
+}
+
+TEST(Inflation, AStepAlongADirectionSofterThanItsModelIsLengthened) {
+  // The anchor at 100 mm with Mooney-Rivlin rubber to ratio 2: with bending on, its walls slide towards each
+  // other at a nearly constant pressure, 90 unshifted SQP steps each lowering the merit by more than the
+  // model predicted, the residual creeping up from 1e-4 N: 237 Newton steps to the answer that the
+  // equilibrium passes through itself. Doubled while the merit falls: 80.
+  const InflationResult result =
+      inflate_corpus_mesh("anchor_dense.off", 100.0, "mooney-rivlin:C1=0.139679,C2=0.0280028", 2.0);
+  ASSERT_EQ(inflation_stop_word(result.stop), std::string("passes_through_itself")) << result.message;
+  EXPECT_NEAR(result.volume_ratio, 2.0, 2.0 * 1e-6);
+  EXPECT_LT(result.newton_iterations, 150);
 }
 
 TEST(Inflation, APathThatStrugglesPastItsWallsTouchingEndsThereWithThatReason) {
