@@ -366,7 +366,7 @@ class InflationRun {
     while (std::abs(target_volume - state.volume) > 1e-14 * target_volume) {
       if (std::exchange(hard_step, false) && stopped_passing_through_itself(state, message)) return false;
       const double next = std::abs(step) >= std::abs(target_volume - state.volume) ? target_volume : state.volume + step;
-      const PathPoint* resume = std::exchange(from_bent_try, false) ? &m_bent_try_unfinished : nullptr;
+      const PathPoint* resume = std::exchange(from_bent_try, false) ? &m_bent_try.unfinished : nullptr;
       const int newton_before = m_newton_iterations;
       if (attempt_volume_step(state, next, report, resume)) {
         if (report.iterations <= 6) step *= 2.0;
@@ -390,7 +390,7 @@ class InflationRun {
         // The same step, now with a stable state: from where the early bent try of this very step ended,
         // rather than repeating it from the predictor. Where that try failed for good, the same attempt
         // would fail the same way (it is deterministic), so the step is cut at once.
-        from_bent_try = m_bent_try_unfinished.x.size() > 0 && m_bent_try_unfinished.volume == next;
+        from_bent_try = m_bent_try.unfinished.x.size() > 0 && m_bent_try.unfinished.volume == next;
         if (from_bent_try || !bent_try_failed_for_good(state, next)) continue;
       }
       step *= stress_free(state) ? 0.25 : 0.5;  // from rest, membrane or bent: see worth_resuming()
@@ -447,21 +447,22 @@ class InflationRun {
 
   /// A membrane under BendingUse::Auto that has not had its early bent try yet.
   bool early_bent_try_available() const {
-    return !m_tried_bending_early && m_options.bending == BendingUse::Auto && !m_model.bending();
+    return m_bent_try.to_volume < 0.0 && m_options.bending == BendingUse::Auto && !m_model.bending();
   }
 
   /// Once per path, the first volume step that creeps through wrinkles as a membrane is tried again with
   /// the sheet's bending on, from where it started. True if that converged (bending then stays on); else
   /// the sheet is a membrane again, with its unfinished attempt as before. `report` becomes the bent
   /// attempt's when that converged or was stopped (time limit, cancel), and stays the membrane's otherwise.
-  /// A failed try that was still converging leaves its end in m_bent_try_unfinished, which the attempt
+  /// A failed try that was still converging leaves its end in m_bent_try.unfinished, which the attempt
   /// right after bending goes on for good at this same step resumes instead of starting over. Without
   /// it the femur at ratio 2 crept through 4 membrane resumes (240 Newton steps) before bending went on;
   /// a bent attempt that fails costs the anchor and knot, whose membrane paths do reach an answer, one
   /// attempt.
   bool try_bending_early(PathPoint& state, double next_volume, NewtonReport& report) {
     if (!early_bent_try_available()) return false;
-    m_tried_bending_early = true;
+    m_bent_try.from_volume = state.volume;
+    m_bent_try.to_volume = next_volume;
     set_bending(true);
     const PathPoint membrane_unfinished = m_unfinished;
     const double membrane_start_residual = m_unfinished_start_residual;
@@ -474,17 +475,18 @@ class InflationRun {
       report = bent;
       return false;
     }
-    if (worth_resuming(bent, state)) m_bent_try_unfinished = m_unfinished;
-    else m_bent_try_failed = {state.volume, next_volume};
+    if (worth_resuming(bent, state)) m_bent_try.unfinished = m_unfinished;
     set_bending(false);
     m_unfinished = membrane_unfinished;
     m_unfinished_start_residual = membrane_start_residual;
     return false;
   }
 
-  /// The early bent try was the step from `state` to `next_volume` and failed without being worth resuming.
+  /// The early bent try was the step from `state` to `next_volume` and failed without being worth resuming
+  /// (asked only while the sheet is still a membrane: a try that converged left bending on).
   bool bent_try_failed_for_good(const PathPoint& state, double next_volume) const {
-    return m_bent_try_failed.from_volume == state.volume && m_bent_try_failed.to_volume == next_volume;
+    return m_bent_try.unfinished.x.size() == 0 && m_bent_try.from_volume == state.volume &&
+           m_bent_try.to_volume == next_volume;
   }
 
   /// A path that struggles has often pushed its walls through each other (the knot's tube near x3.5):
@@ -697,11 +699,12 @@ class InflationRun {
   int m_newton_iterations = 0;
   int m_load_steps = 0;
   int m_unstable_modes = 0;
-  bool m_tried_bending_early = false;  ///< see try_bending_early
-  PathPoint m_bent_try_unfinished;     ///< where that try ended, when it was still converging; else empty
+  /// The early bent try (try_bending_early), once per path: its step, and where it ended when it failed
+  /// while still converging (else empty).
   struct {
-    double from_volume = -1.0, to_volume = -1.0;  ///< mm^3
-  } m_bent_try_failed;  ///< that try's step, when it failed and was not worth resuming
+    double from_volume = -1.0, to_volume = -1.0;  ///< mm^3; negative until tried
+    PathPoint unfinished;
+  } m_bent_try;
   std::string m_final_message = "converged";  ///< the last equilibrium solve's (it may name a rounding floor)
   PathPoint m_unfinished;                   ///< where the last failed attempt ended
   double m_unfinished_start_residual = 0.0;  ///< N, the residual that attempt started from
