@@ -55,35 +55,34 @@ TensionState tension_state(double trace_c, double det_c) {
 /// With `tension_field`, Pipkin's relaxed energy: a wrinkled triangle stores the energy of uniaxial
 /// tension at its largest stretch l1 (l2 = l3 = l1^-1/2: I1 = l1^2 + 2/l1, I2 = 2 l1 + 1/l1^2), a slack
 /// one none.
-template <int N>
-Jet<N> gram_energy(const Material& material, double thickness, const Jet<N>& s11, const Jet<N>& s12,
-                   const Jet<N>& s22, const Jet<N>& m11, const Jet<N>& m12, const Jet<N>& m22,
-                   bool tension_field = false) {
-  const Jet<N> det_m = m11 * m22 - m12 * m12;
-  const Jet<N> numerator = s11 * m22 - 2.0 * (s12 * m12) + s22 * m11;
-  const Jet<N> trace_c = numerator / det_m;
-  const Jet<N> det_s = s11 * s22 - s12 * s12;
-  const Jet<N> det_c = det_s / det_m;
+template <typename J>
+J gram_energy(const Material& material, double thickness, const J& s11, const J& s12, const J& s22, const J& m11,
+              const J& m12, const J& m22, bool tension_field = false) {
+  const J det_m = m11 * m22 - m12 * m12;
+  const J numerator = s11 * m22 - 2.0 * (s12 * m12) + s22 * m11;
+  const J trace_c = numerator / det_m;
+  const J det_s = s11 * s22 - s12 * s12;
+  const J det_c = det_s / det_m;
   const TensionState state = tension_field ? tension_state(trace_c.v, det_c.v) : TensionState::Taut;
-  Jet<N> I1, I2;
+  J I1, I2;
   if (state == TensionState::Slack) {
-    return Jet<N>::constant(0.0);
+    return J::constant(0.0);
   } else if (state == TensionState::Wrinkled) {
     // l1^2 = tr C / 2 + sqrt(tr C^2 / 4 - det C); the discriminant is bounded away from zero here
     // (l2^2 < 1/l1 < l1^2), and its curvature is multiplied by dPsi/dl1^2, which vanishes at l1 = 1.
-    const Jet<N> largest = 0.5 * trace_c + sqrt(0.25 * (trace_c * trace_c) - det_c);
-    const Jet<N> l1 = sqrt(largest);
-    const Jet<N> inv_l1 = inverse(l1);
+    const J largest = 0.5 * trace_c + sqrt(0.25 * (trace_c * trace_c) - det_c);
+    const J l1 = sqrt(largest);
+    const J inv_l1 = inverse(l1);
     I1 = largest + 2.0 * inv_l1;
     I2 = 2.0 * l1 + inv_l1 * inv_l1;
   } else {
-    const Jet<N> inv_det_c = inverse(det_c);
+    const J inv_det_c = inverse(det_c);
     I1 = trace_c + inv_det_c;
     I2 = det_c + trace_c * inv_det_c;
   }
   const InvariantDerivatives d = strain_energy(material, I1.v, I2.v);
-  const Jet<N> psi = apply2(I1, I2, d.psi, d.d1, d.d2, d.d11, d.d12, d.d22);
-  const Jet<N> rest_area = 0.5 * sqrt(det_m);
+  const J psi = apply2(I1, I2, d.psi, d.d1, d.d2, d.d11, d.d12, d.d22);
+  const J rest_area = 0.5 * sqrt(det_m);
   return thickness * (rest_area * psi);
 }
 
@@ -148,13 +147,13 @@ double membrane_energy(const Material& material, double thickness, const RestTri
 
 Vector9d membrane_gradient(const Material& material, double thickness, const RestTriangle& rest, const Vector9d& x,
                            bool tension_field) {
-  // Residuals and line searches call this often: only the 3-variable jet, no 9x9 products.
+  // Residuals and line searches call this often: the 3-variable jet without its Hessian, no 9x9 products.
   const EdgeGram g = edge_gram(x);
   if (collapsed(g)) return Vector9d::Zero();
-  using J3 = Jet<3>;
-  const J3 w = gram_energy<3>(material, thickness, J3::variable(g.s11, 0), J3::variable(g.s12, 1),
-                              J3::variable(g.s22, 2), J3::constant(rest.m11), J3::constant(rest.m12),
-                              J3::constant(rest.m22), tension_field);
+  using J3 = Jet<3, false>;
+  const J3 w = gram_energy(material, thickness, J3::variable(g.s11, 0), J3::variable(g.s12, 1),
+                           J3::variable(g.s22, 2), J3::constant(rest.m11), J3::constant(rest.m12),
+                           J3::constant(rest.m22), tension_field);
   return gram_jacobian(g).transpose() * w.g;
 }
 
@@ -169,9 +168,9 @@ void membrane_energy_gradient_hessian(const Material& material, double thickness
     return;
   }
   using J3 = Jet<3>;
-  const J3 w = gram_energy<3>(material, thickness, J3::variable(g.s11, 0), J3::variable(g.s12, 1),
-                              J3::variable(g.s22, 2), J3::constant(rest.m11), J3::constant(rest.m12),
-                              J3::constant(rest.m22), tension_field);
+  const J3 w = gram_energy(material, thickness, J3::variable(g.s11, 0), J3::variable(g.s12, 1),
+                           J3::variable(g.s22, 2), J3::constant(rest.m11), J3::constant(rest.m12),
+                           J3::constant(rest.m22), tension_field);
   const Eigen::Matrix<double, 3, 9> js = gram_jacobian(g);
   energy = w.v;
   gradient = js.transpose() * w.g;
@@ -201,9 +200,9 @@ Matrix9d membrane_mixed_derivative(const Material& material, double thickness, c
   const EdgeGram g = edge_gram(x);
   const EdgeGram m = edge_gram(rest);
   using J6 = Jet<6>;
-  const J6 w = gram_energy<6>(material, thickness, J6::variable(g.s11, 0), J6::variable(g.s12, 1),
-                              J6::variable(g.s22, 2), J6::variable(m.s11, 3), J6::variable(m.s12, 4),
-                              J6::variable(m.s22, 5), tension_field);
+  const J6 w = gram_energy(material, thickness, J6::variable(g.s11, 0), J6::variable(g.s12, 1),
+                           J6::variable(g.s22, 2), J6::variable(m.s11, 3), J6::variable(m.s12, 4),
+                           J6::variable(m.s22, 5), tension_field);
   // gradient_x = Js(x)^T dW/ds(s, m(rest)), so d/d(rest) = Js^T d2W/(ds dm) Jm.
   return gram_jacobian(g).transpose() * w.h.block<3, 3>(0, 3) * gram_jacobian(m);
 }

@@ -104,6 +104,26 @@ TEST_P(MembraneElementTest, HessianMatchesFiniteDifferencesOfGradient) {
   }
 }
 
+TEST_P(MembraneElementTest, TheGradientAloneEqualsTheGradientComputedWithTheHessian) {
+  // membrane_gradient carries no Hessian through its jet (residuals and line searches call it most); its
+  // gradient comes from the same expressions, so it agrees to rounding, plain and relaxed.
+  const Case c = GetParam();
+  std::mt19937 rng(19);
+  for (int trial = 0; trial < 5; ++trial) {
+    const Vector9d rest = rest_triangle(rng, c.sliver);
+    const Vector9d x = deformed_triangle(rng, rest, c.stretch);
+    const RestTriangle r = make_rest_triangle(rest);
+    for (const bool tension_field : {false, true}) {
+      double energy;
+      Vector9d with_hessian;
+      Matrix9d hessian;
+      membrane_energy_gradient_hessian(c.material, 0.5, r, x, energy, with_hessian, hessian, false, tension_field);
+      const Vector9d alone = membrane_gradient(c.material, 0.5, r, x, tension_field);
+      EXPECT_LE((alone - with_hessian).norm(), 1e-14 * with_hessian.norm()) << c.label << " trial " << trial;
+    }
+  }
+}
+
 TEST_P(MembraneElementTest, MixedRestDerivativeMatchesFiniteDifferences) {
   const Case c = GetParam();
   std::mt19937 rng(13);
