@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <random>
+#include <vector>
 
 #include "core/central_differences.hpp"
 #include "fem/membrane_element.hpp"
@@ -61,6 +62,24 @@ Vector9d deformed_triangle(std::mt19937& rng, const Vector9d& rest, double stret
   return x;
 }
 
+/// Five rest triangles of the case's kind, each with its deformed copy and its rest data, drawn from `seed`.
+struct Trial {
+  Vector9d rest, x;
+  RestTriangle r;
+};
+std::vector<Trial> trials(const Case& c, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::vector<Trial> all;
+  for (int k = 0; k < 5; ++k) {
+    Trial t;
+    t.rest = rest_triangle(rng, c.sliver);
+    t.x = deformed_triangle(rng, t.rest, c.stretch);
+    t.r = make_rest_triangle(t.rest);
+    all.push_back(t);
+  }
+  return all;
+}
+
 double relative_error(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return (a - b).norm() / std::max(a.norm(), b.norm());
 }
@@ -69,11 +88,9 @@ class MembraneElementTest : public ::testing::TestWithParam<Case> {};
 
 TEST_P(MembraneElementTest, GradientMatchesFiniteDifferencesOfEnergy) {
   const Case c = GetParam();
-  std::mt19937 rng(7);
-  for (int trial = 0; trial < 5; ++trial) {
-    const Vector9d rest = rest_triangle(rng, c.sliver);
-    const Vector9d x = deformed_triangle(rng, rest, c.stretch);
-    const RestTriangle r = make_rest_triangle(rest);
+  const std::vector<Trial> all = trials(c, 7);
+  for (size_t trial = 0; trial < all.size(); ++trial) {
+    const auto& [rest, x, r] = all[trial];
     const Vector9d analytic = membrane_gradient(c.material, 0.5, r, x);
     const double step = 1e-6 * x.norm() * (c.sliver ? 1e-2 : 1.0);
     const Vector9d numeric = test::central_difference_gradient(
@@ -86,11 +103,9 @@ TEST_P(MembraneElementTest, GradientMatchesFiniteDifferencesOfEnergy) {
 
 TEST_P(MembraneElementTest, HessianMatchesFiniteDifferencesOfGradient) {
   const Case c = GetParam();
-  std::mt19937 rng(11);
-  for (int trial = 0; trial < 5; ++trial) {
-    const Vector9d rest = rest_triangle(rng, c.sliver);
-    const Vector9d x = deformed_triangle(rng, rest, c.stretch);
-    const RestTriangle r = make_rest_triangle(rest);
+  const std::vector<Trial> all = trials(c, 11);
+  for (size_t trial = 0; trial < all.size(); ++trial) {
+    const auto& [rest, x, r] = all[trial];
     double energy;
     Vector9d gradient;
     Matrix9d analytic;
@@ -108,11 +123,9 @@ TEST_P(MembraneElementTest, TheGradientAloneEqualsTheGradientComputedWithTheHess
   // membrane_gradient carries no Hessian through its jet (residuals and line searches call it most); its
   // gradient comes from the same expressions, so it agrees to rounding, plain and relaxed.
   const Case c = GetParam();
-  std::mt19937 rng(19);
-  for (int trial = 0; trial < 5; ++trial) {
-    const Vector9d rest = rest_triangle(rng, c.sliver);
-    const Vector9d x = deformed_triangle(rng, rest, c.stretch);
-    const RestTriangle r = make_rest_triangle(rest);
+  const std::vector<Trial> all = trials(c, 19);
+  for (size_t trial = 0; trial < all.size(); ++trial) {
+    const auto& [rest, x, r] = all[trial];
     for (const bool tension_field : {false, true}) {
       double energy;
       Vector9d with_hessian;
@@ -126,10 +139,9 @@ TEST_P(MembraneElementTest, TheGradientAloneEqualsTheGradientComputedWithTheHess
 
 TEST_P(MembraneElementTest, MixedRestDerivativeMatchesFiniteDifferences) {
   const Case c = GetParam();
-  std::mt19937 rng(13);
-  for (int trial = 0; trial < 5; ++trial) {
-    const Vector9d rest = rest_triangle(rng, c.sliver);
-    const Vector9d x = deformed_triangle(rng, rest, c.stretch);
+  const std::vector<Trial> all = trials(c, 13);
+  for (size_t trial = 0; trial < all.size(); ++trial) {
+    const auto& [rest, x, r] = all[trial];
     const Matrix9d analytic = membrane_mixed_derivative(c.material, 0.5, rest, x);
     const double step = 1e-6 * rest.norm() * (c.sliver ? 1e-2 : 1.0);
     const Matrix9d numeric = test::central_difference_jacobian(
