@@ -321,7 +321,8 @@ NewtonReport EquilibriumSolver::newton_volume(Eigen::VectorXd& x, double& pressu
     m_last_step_exact = false;
     const bool exact_tried = exact_worth_trying && m_exact_fails_left == 0;
     if (exact_tried) residual_at_exact_try = report.residual_norm;
-    const bool exact_factorized = exact_tried && factorize_exact_for_volume(x, pressure_mpa, v);
+    KktSolves solved;
+    const bool exact_factorized = exact_tried && factorize_exact_for_volume(x, pressure_mpa, v, r, solved);
     if (exact_factorized) {
       ++report.exact_factorizations;
       if (m_solver.negative_pivots() > 0) ++report.indefinite_factorizations;
@@ -331,11 +332,11 @@ NewtonReport EquilibriumSolver::newton_volume(Eigen::VectorXd& x, double& pressu
       // direction that the volume constraint removes): the exact step descends on the augmented
       // Lagrangian, a better guide than the residual norm far from a solution. (Past the maximum the
       // residual norm took the femur at 20 mm, Neo-Hookean x8, through 564 Newton steps; this, 343.)
-      exact = constrained_descent(x, pressure_mpa, target_volume, v, r, c, true) >= 0;
+      exact = constrained_descent(x, pressure_mpa, target_volume, v, r, c, solved, true) >= 0;
       if (!exact) m_exact_fails_left = 2;
     } else if (exact_factorized) {
-      const Eigen::VectorXd a = -m_solver.solve(r);
-      const Eigen::VectorXd b = m_solver.solve(v);
+      const Eigen::VectorXd a = -solved.of_residual;
+      const Eigen::VectorXd& b = solved.of_volume_gradient;
       const double vb = v.dot(b);
       if (std::abs(vb) > 0.0) {
         const double dp = (-c - v.dot(a)) / vb;
@@ -373,10 +374,12 @@ NewtonReport EquilibriumSolver::newton_volume(Eigen::VectorXd& x, double& pressu
 }
 
 bool EquilibriumSolver::factorize_exact_for_volume(const Eigen::VectorXd& x, double pressure_mpa,
-                                                   const Eigen::VectorXd& v) {
+                                                   const Eigen::VectorXd& v, const Eigen::VectorXd& r,
+                                                   KktSolves& solved) {
   m_model.assemble_hessian(x, pressure_mpa, m_assembly, false);
   if (!m_exact_indefinite && m_solver.factorize_llt(m_assembly.values()) == SparseSolver::Status::Ok) {
     m_last_unstable_modes = 0;
+    solved = solve_kkt(r, v);
     return true;
   }
   if (m_skip_ldlt > 0) {
@@ -391,13 +394,20 @@ bool EquilibriumSolver::factorize_exact_for_volume(const Eigen::VectorXd& x, dou
   // A stable volume-controlled state has exactly one negative eigenvalue there (the constraint's); each
   // more is an unstable direction (a wrinkling or symmetry-breaking mode). Newton still converges to such
   // saddles when started close, and the caller's residual line search decides whether a step is good.
-  m_last_unstable_modes = std::max(0, kkt_negative_eigenvalues(v) - 1);
+  solved = solve_kkt(r, v);
+  m_last_unstable_modes = std::max(0, kkt_negative_eigenvalues(v, solved) - 1);
   return true;
 }
 
+EquilibriumSolver::KktSolves EquilibriumSolver::solve_kkt(const Eigen::VectorXd& r, const Eigen::VectorXd& v) const {
+  Eigen::MatrixXd rhs(r.size(), 2);
+  rhs << r, v;
+  const Eigen::MatrixXd solution = m_solver.solve_columns(rhs);
+  return {solution.col(0), solution.col(1)};
+}
 
-int EquilibriumSolver::kkt_negative_eigenvalues(const Eigen::VectorXd& v) const {
-  return m_solver.negative_pivots() + (v.dot(m_solver.solve(v)) > 0.0 ? 1 : 0);
+int EquilibriumSolver::kkt_negative_eigenvalues(const Eigen::VectorXd& v, const KktSolves& solved) const {
+  return m_solver.negative_pivots() + (v.dot(solved.of_volume_gradient) > 0.0 ? 1 : 0);
 }
 
 bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
@@ -414,12 +424,16 @@ bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, doubl
   // definite model, which sends the next one back to LL^T): past a pressure maximum the LL^T attempt
   // failed at step after step, each costing about 60% of a factorization (dino, Neo-Hookean: 500 failed
   // attempts, 28% of the factorization time).
+  KktSolves solved;
   auto minimum_inertia = [&](double trial_shift) {
-    if (!m_sqp_indefinite && m_solver.factorize_llt(m_assembly.values(), trial_shift) == SparseSolver::Status::Ok)
+    if (!m_sqp_indefinite && m_solver.factorize_llt(m_assembly.values(), trial_shift) == SparseSolver::Status::Ok) {
+      solved = solve_kkt(r, v);
       return true;
+    }
     if (m_solver.factorize_ldlt(m_assembly.values(), trial_shift) != SparseSolver::Status::Ok) return false;
     m_sqp_indefinite = m_solver.negative_pivots() > 0;
-    return kkt_negative_eigenvalues(v) == 1;
+    solved = solve_kkt(r, v);
+    return kkt_negative_eigenvalues(v, solved) == 1;
   };
   // With settings.shift_after_cut_short, the step after one cut short starts at the raised shift instead
   // of trying the unshifted model first: on the femur at 20 mm (Neo-Hookean x8) that model, nearly
@@ -434,7 +448,7 @@ bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, doubl
     if (!factorized) shift *= 10.0;
   }
   m_sqp_shift = shift;
-  const int halvings = constrained_descent(x, pressure_mpa, target_volume, v, r, c, false);
+  const int halvings = constrained_descent(x, pressure_mpa, target_volume, v, r, c, solved, false);
   if (halvings >= 0) {
     // Cut short more than twice: the shifted model was too bold, so the next one starts stiffer. (Only
     // here: exact steps cut short once raised it too, x4 per step without bound, until a later SQP
@@ -452,10 +466,10 @@ bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, doubl
 
 int EquilibriumSolver::constrained_descent(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
                                            const Eigen::VectorXd& v, const Eigen::VectorXd& r, double c,
-                                           bool exact_model) {
+                                           const KktSolves& solved, bool exact_model) {
   // KKT step of the factorized positive definite model H: H dx - dp v = -r, v.dx = -c.
-  const Eigen::VectorXd a = m_solver.solve(r);
-  const Eigen::VectorXd b = m_solver.solve(v);
+  const Eigen::VectorXd& a = solved.of_residual;
+  const Eigen::VectorXd& b = solved.of_volume_gradient;
   const double vb = v.dot(b);
   if (!(std::abs(vb) > 0.0)) return -1;
   const double dp = (v.dot(a) - c) / vb;

@@ -152,9 +152,15 @@ class EquilibriumSolver {
   bool at_rounding_floor(const Eigen::VectorXd& x, double pressure_mpa, const Eigen::VectorXd& r,
                          double previous_residual, double force_scale_n, NewtonReport& report) const;
 
+  /// K^-1 r and K^-1 v with the last factorization, the two solves a volume-controlled step needs, made
+  /// in one pass over the factors.
+  struct KktSolves {
+    Eigen::VectorXd of_residual, of_volume_gradient;
+  };
+  KktSolves solve_kkt(const Eigen::VectorXd& r, const Eigen::VectorXd& v) const;
   /// Negative eigenvalues of the bordered KKT matrix [K v; v^T 0] for the last LDL^T factorization of K
-  /// (Haynsworth: the inertia of K plus the sign of -v^T K^-1 v).
-  int kkt_negative_eigenvalues(const Eigen::VectorXd& v) const;
+  /// (Haynsworth: the inertia of K plus the sign of -v^T K^-1 v), given `solved` = solve_kkt(r, v).
+  int kkt_negative_eigenvalues(const Eigen::VectorXd& v, const KktSolves& solved) const;
   /// One SQP step for volume control with a positive definite model of the Hessian (projected membrane
   /// blocks plus a Levenberg shift), globalised on the augmented Lagrangian at the new multiplier.
   /// `settings` gives shift_restart and shift_after_cut_short.
@@ -168,16 +174,19 @@ class EquilibriumSolver {
   /// cost the femur at 200 mm (silicone x8) 478 Newton steps instead of 138 and the second made fandisk
   /// (latex x27) and the knot (Neo-Hookean x8) creep to the time limit; in the design's trials on its
   /// pinned support the correction cost latex designs iterations (teddy 5.1x -> 3.7x, spot 6.9x -> 6.0x).
+  /// `solved` = solve_kkt(r, v) with that factorization.
   int constrained_descent(Eigen::VectorXd& x, double& pressure_mpa, double target_volume, const Eigen::VectorXd& v,
-                          const Eigen::VectorXd& r, double c, bool exact_model);
+                          const Eigen::VectorXd& r, double c, const KktSolves& solved, bool exact_model);
   NewtonReport newton_volume(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
                              const NewtonSettings& settings);
   /// After a solve on a rigid support: back to the held values, and the residual measured there.
   void return_to_support(Eigen::VectorXd& x, const Eigen::VectorXd& held, double pressure_mpa, NewtonReport& report) const;
   /// LDL^T of the exact stiffness assembled last; records whether it was indefinite.
   bool factorize_exact_ldlt();
-  /// Exact stiffness for the volume-controlled KKT step, accepted when its inertia is right.
-  bool factorize_exact_for_volume(const Eigen::VectorXd& x, double pressure_mpa, const Eigen::VectorXd& v);
+  /// Exact stiffness for the volume-controlled KKT step, accepted when its inertia is right; fills
+  /// `solved` = solve_kkt(r, v) when it was factorized.
+  bool factorize_exact_for_volume(const Eigen::VectorXd& x, double pressure_mpa, const Eigen::VectorXd& v,
+                                  const Eigen::VectorXd& r, KktSolves& solved);
 
   fem::BalloonModel& m_model;
   fem::TriangleAssembly m_assembly;

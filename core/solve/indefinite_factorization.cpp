@@ -162,15 +162,17 @@ IndefiniteFactorization::Status IndefiniteFactorization::factorize(const std::ve
   return Status::Ok;
 }
 
-Eigen::VectorXd IndefiniteFactorization::solve(const Eigen::VectorXd& rhs) const {
+Eigen::VectorXd IndefiniteFactorization::solve(const Eigen::VectorXd& rhs) const { return solve_columns(rhs).col(0); }
+
+Eigen::MatrixXd IndefiniteFactorization::solve_columns(const Eigen::MatrixXd& rhs) const {
   if (!m->factorized) throw std::logic_error("IndefiniteFactorization::solve without a successful factorization");
-  if (rhs.size() != m->n) throw std::invalid_argument("IndefiniteFactorization::solve: size mismatch");
-  Eigen::VectorXd solution = rhs;
-  if (m->n == 0) return solution;
+  if (rhs.rows() != m->n) throw std::invalid_argument("IndefiniteFactorization::solve: size mismatch");
+  Eigen::MatrixXd solution = rhs;
+  if (m->n == 0 || rhs.cols() == 0) return solution;
   std::lock_guard<std::mutex> guard(mumps_lock());
   DMUMPS_STRUC_C& mumps = m->mumps;
   mumps.rhs = solution.data();
-  mumps.nrhs = 1;
+  mumps.nrhs = static_cast<int>(rhs.cols());
   mumps.lrhs = m->n;
   m->call(JOB_SOLVE);
   mumps.rhs = nullptr;

@@ -29,6 +29,8 @@ class IndefiniteFactorization {
   int negative_pivots() const { return m_negative; }
   /// Solves with the last successful factorization.
   Eigen::VectorXd solve(const Eigen::VectorXd& rhs) const;
+  /// The same for each column of `rhs`, in one pass over the factors.
+  Eigen::MatrixXd solve_columns(const Eigen::MatrixXd& rhs) const;
 
  private:
   struct Internals;

@@ -110,22 +110,24 @@ SparseSolver::Status SparseSolver::factorize_ldlt(const std::vector<double>& val
 
 int SparseSolver::negative_pivots() const { return m->negative; }
 
-Eigen::VectorXd SparseSolver::solve(const Eigen::VectorXd& rhs) const {
+Eigen::VectorXd SparseSolver::solve(const Eigen::VectorXd& rhs) const { return solve_columns(rhs).col(0); }
+
+Eigen::MatrixXd SparseSolver::solve_columns(const Eigen::MatrixXd& rhs) const {
   if (m->last == Internals::Factor::None) throw std::logic_error("SparseSolver::solve without a successful factorization");
-  if (rhs.size() != m->n) throw std::invalid_argument("SparseSolver::solve: size mismatch");
+  if (rhs.rows() != m->n) throw std::invalid_argument("SparseSolver::solve: size mismatch");
   if (!rhs.allFinite()) throw std::invalid_argument("SparseSolver::solve: non-finite right-hand side");
-  if (m->last == Internals::Factor::Ldlt) return m->ldlt->solve(rhs);
+  if (m->last == Internals::Factor::Ldlt) return m->ldlt->solve_columns(rhs);
   cholmod_dense b{};
   b.nrow = static_cast<size_t>(m->n);
-  b.ncol = 1;
-  b.nzmax = static_cast<size_t>(m->n);
+  b.ncol = static_cast<size_t>(rhs.cols());
+  b.nzmax = b.nrow * b.ncol;
   b.d = static_cast<size_t>(m->n);
   b.x = const_cast<double*>(rhs.data());
   b.xtype = CHOLMOD_REAL;
   b.dtype = CHOLMOD_DOUBLE;
   cholmod_dense* x = cholmod_solve(CHOLMOD_A, m->llt, &b, &m->common);
   if (!x) throw std::runtime_error("SparseSolver::solve: CHOLMOD solve failed");
-  Eigen::VectorXd out = Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(x->x), m->n);
+  Eigen::MatrixXd out = Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(x->x), m->n, rhs.cols());
   cholmod_free_dense(&x, &m->common);
   return out;
 }

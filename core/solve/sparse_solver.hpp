@@ -31,6 +31,10 @@ class SparseSolver {
 
   /// Solves with the last factorization. Non-finite right-hand sides are rejected.
   Eigen::VectorXd solve(const Eigen::VectorXd& rhs) const;
+  /// The same for each column of `rhs`. One pass over the factors serves every column: a solve with one
+  /// right-hand side costs the memory traffic of reading the whole factor, so two columns at once cost
+  /// little more than one.
+  Eigen::MatrixXd solve_columns(const Eigen::MatrixXd& rhs) const;
 
   /// Number of numeric factorizations done so far.
   int factorizations() const { return m_factorizations; }

@@ -64,6 +64,31 @@ TEST(IndefiniteFactorization, InertiaAndSolveMatchTheDenseReference) {
   }
 }
 
+TEST(IndefiniteFactorization, SeveralColumnsSolveAsEachAloneWithEitherFactorization) {
+  // The Newton steps solve K^-1 r and K^-1 v in one pass; each column must be what its own solve gives,
+  // with the supernodal LL^T (positive definite) and with MUMPS's LDL^T (indefinite).
+  for (int negative : {0, 3}) {
+    const BandedMatrix matrix(60, negative, 40u + static_cast<unsigned>(negative));
+    SparseSolver solver;
+    solver.set_pattern(60, matrix.column_starts, matrix.row_indices);
+    if (negative == 0) {
+      ASSERT_EQ(solver.factorize_llt(matrix.values), SparseSolver::Status::Ok);
+    } else {
+      ASSERT_EQ(solver.factorize_ldlt(matrix.values), SparseSolver::Status::Ok);
+      ASSERT_EQ(solver.negative_pivots(), negative);
+    }
+    Eigen::MatrixXd rhs(60, 3);
+    rhs << Eigen::VectorXd::LinSpaced(60, -1.0, 2.0), Eigen::VectorXd::Ones(60), Eigen::VectorXd::LinSpaced(60, 3.0, 0.0);
+    const Eigen::MatrixXd together = solver.solve_columns(rhs);
+    ASSERT_EQ(together.cols(), 3);
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::VectorXd alone = solver.solve(rhs.col(k));
+      EXPECT_LT((together.col(k) - alone).norm(), 1e-13 * alone.norm()) << negative << " negative, column " << k;
+      EXPECT_LT((matrix.dense * together.col(k) - rhs.col(k)).norm(), 1e-12 * rhs.col(k).norm());
+    }
+  }
+}
+
 TEST(IndefiniteFactorization, OneFactorizationServesManyMatricesAndPatternsInItsOwnWorkspace) {
   // The factorization keeps MUMPS's workspace from one call to the next (and the factors live in it until
   // the next call): matrices of one pattern one after another, then a larger pattern, then the first
