@@ -426,14 +426,14 @@ bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, doubl
   // attempts, 28% of the factorization time).
   KktSolves solved;
   auto minimum_inertia = [&](double trial_shift) {
-    if (!m_sqp_indefinite && m_solver.factorize_llt(m_assembly.values(), trial_shift) == SparseSolver::Status::Ok) {
-      solved = solve_kkt(r, v);
-      return true;
+    const bool positive_definite =
+        !m_sqp_indefinite && m_solver.factorize_llt(m_assembly.values(), trial_shift) == SparseSolver::Status::Ok;
+    if (!positive_definite) {
+      if (m_solver.factorize_ldlt(m_assembly.values(), trial_shift) != SparseSolver::Status::Ok) return false;
+      m_sqp_indefinite = m_solver.negative_pivots() > 0;
     }
-    if (m_solver.factorize_ldlt(m_assembly.values(), trial_shift) != SparseSolver::Status::Ok) return false;
-    m_sqp_indefinite = m_solver.negative_pivots() > 0;
     solved = solve_kkt(r, v);
-    return kkt_negative_eigenvalues(v, solved) == 1;
+    return positive_definite || kkt_negative_eigenvalues(v, solved) == 1;
   };
   // With settings.shift_after_cut_short, the step after one cut short starts at the raised shift instead
   // of trying the unshifted model first: on the femur at 20 mm (Neo-Hookean x8) that model, nearly
