@@ -10,26 +10,44 @@
 namespace balloon::fem {
 namespace {
 
+/// What the angle, its gradient and its Hessian share: the hinge edge and the two triangles' normals.
+struct HingeTerms {
+  Eigen::Vector3d edge, unit_edge, normal_a, normal_b;
+  double length;
+};
+
+HingeTerms hinge_terms(const Vector12d& x) {
+  HingeTerms t;
+  const Eigen::Vector3d x0 = x.segment<3>(0), x1 = x.segment<3>(3), x2 = x.segment<3>(6), x3 = x.segment<3>(9);
+  t.edge = x1 - x0;
+  t.normal_a = t.edge.cross(x2 - x0);
+  t.normal_b = (x0 - x1).cross(x3 - x1);
+  t.length = t.edge.norm();
+  t.unit_edge = t.edge / t.length;
+  return t;
+}
+
+double dihedral_angle(const HingeTerms& t) {
+  return std::atan2(t.normal_a.cross(t.normal_b).dot(t.edge) / t.length, t.normal_a.dot(t.normal_b));
+}
+
 /// Gradient of the dihedral angle in closed form (Bridson, Marino and Fedkiw, "Simulation of clothing with
 /// folds and wrinkles", SCA 2003): each triangle's normal direction, weighted by the lever arms of its
 /// vertices about the hinge.
-Vector12d dihedral_angle_gradient(const Vector12d& x) {
+Vector12d dihedral_angle_gradient(const Vector12d& x, const HingeTerms& t) {
   using Eigen::Vector3d;
   const Vector3d x0 = x.segment<3>(0), x1 = x.segment<3>(3), x2 = x.segment<3>(6), x3 = x.segment<3>(9);
-  const Vector3d edge = x1 - x0;
-  const Vector3d normal_a = edge.cross(x2 - x0);
-  const Vector3d normal_b = (x0 - x1).cross(x3 - x1);
-  const double length = edge.norm();
-  const Vector3d a = normal_a / normal_a.squaredNorm();
-  const Vector3d b = normal_b / normal_b.squaredNorm();
-  const Vector3d unit_edge = edge / length;
+  const Vector3d a = t.normal_a / t.normal_a.squaredNorm();
+  const Vector3d b = t.normal_b / t.normal_b.squaredNorm();
   Vector12d g;
-  g.segment<3>(0) = -((x2 - x1).dot(unit_edge) * a + (x3 - x1).dot(unit_edge) * b);
-  g.segment<3>(3) = (x2 - x0).dot(unit_edge) * a + (x3 - x0).dot(unit_edge) * b;
-  g.segment<3>(6) = -length * a;
-  g.segment<3>(9) = -length * b;
+  g.segment<3>(0) = -((x2 - x1).dot(t.unit_edge) * a + (x3 - x1).dot(t.unit_edge) * b);
+  g.segment<3>(3) = (x2 - x0).dot(t.unit_edge) * a + (x3 - x0).dot(t.unit_edge) * b;
+  g.segment<3>(6) = -t.length * a;
+  g.segment<3>(9) = -t.length * b;
   return g;
 }
+
+Vector12d dihedral_angle_gradient(const Vector12d& x) { return dihedral_angle_gradient(x, hinge_terms(x)); }
 
 Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& v) {
   Eigen::Matrix3d m;
@@ -49,23 +67,18 @@ Jacobian3x12 blocks(const Eigen::Matrix3d& b0, const Eigen::Matrix3d& b1, const 
 /// The dihedral angle's Hessian: the derivative of dihedral_angle_gradient's expressions, term by term
 /// (product and quotient rules on its normals, lever arms and edge length). It replaced forward-mode
 /// automatic differentiation of that gradient (12 directions carried through every operation).
-Matrix12d dihedral_angle_hessian(const Vector12d& x) {
+Matrix12d dihedral_angle_hessian(const Vector12d& x, const HingeTerms& t) {
   using Eigen::Matrix3d;
   using Eigen::Vector3d;
-  const Vector3d x0 = x.segment<3>(0), x1 = x.segment<3>(3), x2 = x.segment<3>(6), x3 = x.segment<3>(9);
-  const Vector3d edge = x1 - x0, to_a = x2 - x0, to_b = x3 - x1;
-  const Vector3d normal_a = edge.cross(to_a);
-  const Vector3d normal_b = -edge.cross(to_b);
-  const double length = edge.norm();
-  const Vector3d unit_edge = edge / length;
+  const Vector3d to_a = x.segment<3>(6) - x.segment<3>(0), to_b = x.segment<3>(9) - x.segment<3>(3);
   const Matrix3d I = Matrix3d::Identity(), O = Matrix3d::Zero();
 
   // d(edge) = dx1 - dx0; the unit edge and the length follow it.
   const Jacobian3x12 d_edge = blocks(-I, I, O, O);
-  const Jacobian3x12 d_unit_edge = (I - unit_edge * unit_edge.transpose()) / length * d_edge;
-  const Eigen::Matrix<double, 1, 12> d_length = unit_edge.transpose() * d_edge;
+  const Jacobian3x12 d_unit_edge = (I - t.unit_edge * t.unit_edge.transpose()) / t.length * d_edge;
+  const Eigen::Matrix<double, 1, 12> d_length = t.unit_edge.transpose() * d_edge;
   // normal_a = edge x (x2 - x0), normal_b = -edge x (x3 - x1).
-  const Matrix3d edge_x = cross_matrix(edge), to_a_x = cross_matrix(to_a), to_b_x = cross_matrix(to_b);
+  const Matrix3d edge_x = cross_matrix(t.edge), to_a_x = cross_matrix(to_a), to_b_x = cross_matrix(to_b);
   const Jacobian3x12 d_normal_a = blocks(to_a_x - edge_x, -to_a_x, edge_x, O);
   const Jacobian3x12 d_normal_b = blocks(-to_b_x, to_b_x + edge_x, O, -edge_x);
   // a = n / |n|^2: da = (I - 2 n n^T / |n|^2) dn / |n|^2.
@@ -76,15 +89,15 @@ Matrix12d dihedral_angle_hessian(const Vector12d& x) {
   };
   Vector3d a, b;
   Jacobian3x12 da, db;
-  scaled_normal(normal_a, d_normal_a, a, da);
-  scaled_normal(normal_b, d_normal_b, b, db);
+  scaled_normal(t.normal_a, d_normal_a, a, da);
+  scaled_normal(t.normal_b, d_normal_b, b, db);
   // Lever arm (p - q) . unit_edge of stencil vertices p, q, and its derivative.
   auto lever = [&](int p, int q, double& value, Eigen::Matrix<double, 1, 12>& derivative) {
     const Vector3d arm = x.segment<3>(3 * p) - x.segment<3>(3 * q);
-    value = arm.dot(unit_edge);
+    value = arm.dot(t.unit_edge);
     derivative = arm.transpose() * d_unit_edge;
-    derivative.segment<3>(3 * p) += unit_edge.transpose();
-    derivative.segment<3>(3 * q) -= unit_edge.transpose();
+    derivative.segment<3>(3 * p) += t.unit_edge.transpose();
+    derivative.segment<3>(3 * q) -= t.unit_edge.transpose();
   };
   double a_from_1, b_from_1, a_from_0, b_from_0;
   Eigen::Matrix<double, 1, 12> d_a_from_1, d_b_from_1, d_a_from_0, d_b_from_0;
@@ -96,8 +109,8 @@ Matrix12d dihedral_angle_hessian(const Vector12d& x) {
   Matrix12d h;
   h.middleRows<3>(0) = -(a * d_a_from_1 + a_from_1 * da + b * d_b_from_1 + b_from_1 * db);
   h.middleRows<3>(3) = a * d_a_from_0 + a_from_0 * da + b * d_b_from_0 + b_from_0 * db;
-  h.middleRows<3>(6) = -(a * d_length + length * da);
-  h.middleRows<3>(9) = -(b * d_length + length * db);
+  h.middleRows<3>(6) = -(a * d_length + t.length * da);
+  h.middleRows<3>(9) = -(b * d_length + t.length * db);
   return h;
 }
 
@@ -151,13 +164,7 @@ double bending_modulus(double shear_modulus_mpa, double thickness_mm) {
   return shear_modulus_mpa * thickness_mm * thickness_mm * thickness_mm / 3.0;
 }
 
-double dihedral_angle(const Vector12d& x) {
-  const Eigen::Vector3d x0 = x.segment<3>(0), x1 = x.segment<3>(3), x2 = x.segment<3>(6), x3 = x.segment<3>(9);
-  const Eigen::Vector3d edge = x1 - x0;
-  const Eigen::Vector3d normal_a = edge.cross(x2 - x0);
-  const Eigen::Vector3d normal_b = (x0 - x1).cross(x3 - x1);
-  return std::atan2(normal_a.cross(normal_b).dot(edge) / edge.norm(), normal_a.dot(normal_b));
-}
+double dihedral_angle(const Vector12d& x) { return dihedral_angle(hinge_terms(x)); }
 
 RestHinge make_rest_hinge(const Vector12d& rest, double bending_modulus_nmm) {
   RestHinge hinge;
@@ -176,19 +183,21 @@ double hinge_energy(const RestHinge& rest, const Vector12d& x) {
 
 void hinge_energy_gradient_hessian(const RestHinge& rest, const Vector12d& x, double& energy, Vector12d& gradient,
                                    Matrix12d& hessian, bool project_to_psd) {
-  const double bend = bend_angle(dihedral_angle(x), rest.rest_angle);
+  const HingeTerms terms = hinge_terms(x);
+  const double bend = bend_angle(dihedral_angle(terms), rest.rest_angle);
   energy = rest.stiffness * bend * bend;
-  const Vector12d angle_gradient = dihedral_angle_gradient(x);
+  const Vector12d angle_gradient = dihedral_angle_gradient(x, terms);
   gradient = 2.0 * rest.stiffness * bend * angle_gradient;
   hessian = 2.0 * rest.stiffness * angle_gradient * angle_gradient.transpose();
   if (project_to_psd || bend == 0.0) return;
-  const Matrix12d angle_hessian = dihedral_angle_hessian(x);
+  const Matrix12d angle_hessian = dihedral_angle_hessian(x, terms);
   hessian += 2.0 * rest.stiffness * bend * 0.5 * (angle_hessian + angle_hessian.transpose());
 }
 
 Vector12d hinge_energy_gradient(const RestHinge& rest, const Vector12d& x) {
-  const double bend = bend_angle(dihedral_angle(x), rest.rest_angle);
-  return 2.0 * rest.stiffness * bend * dihedral_angle_gradient(x);
+  const HingeTerms terms = hinge_terms(x);
+  const double bend = bend_angle(dihedral_angle(terms), rest.rest_angle);
+  return 2.0 * rest.stiffness * bend * dihedral_angle_gradient(x, terms);
 }
 
 Matrix12d hinge_mixed_derivative(const RestHinge& rest_hinge, const Vector12d& rest, const Vector12d& x) {
