@@ -14,6 +14,10 @@ TEST(ThinSheet, IssueTensSmallestBalloonIsThinAndAUnitScaleMeshIsNot) {
   // Issue 10's smallest balloon (10 mm across, 0.5 mm) sits at half the limit; the limit itself passes.
   EXPECT_EQ(thin_sheet_problem(0.5, 10.0), "");
   EXPECT_EQ(thin_sheet_problem(0.5, 0.5 / MAX_THICKNESS_PER_DIAGONAL), "");
+  // A 10 mm design target at x8 starts at 5 mm, exactly at the limit; remeshed to 1,500 vertices its start
+  // is 4.99 mm across (10.02%), which must still pass. 10.3% does not.
+  EXPECT_EQ(thin_sheet_problem(0.5, 4.99), "");
+  EXPECT_NE(thin_sheet_problem(0.5, 0.5 / 0.103), "");
   // A mesh in unit coordinates (the 37k bunny is 1.6 units across) read as mm: refused, with the fix.
   const std::string bunny = thin_sheet_problem(0.5, 1.6);
   EXPECT_NE(bunny.find("31.2%"), std::string::npos) << bunny;
