@@ -45,6 +45,12 @@ std::string format_fraction(double fraction) {
   return text;
 }
 
+/// Why a design within MATCH_TOLERANCE_REL of its target stopped.
+std::string matched_message() {
+  return "matched: the inflated shape matches the target to " + format_fraction(MATCH_TOLERANCE_REL) +
+         " of its bounding-box diagonal";
+}
+
 /// A ratio as a short human string: 131.4 -> "131x", 0.002 -> "0.002x".
 std::string format_ratio(double ratio) {
   char text[32];
@@ -92,6 +98,12 @@ class ReducedSpaceDesign {
       stall_reference = resumed.avg_mm;
       m_objective.grow_surface_weight(m_options.resume->iteration);  // where the interrupted design had it
       m_driver.debug_time("resumed from the checkpoint");
+    }
+    // A start that already matches (a regular icosahedron inflates onto itself) is done: with nothing left
+    // to descend, the first line search would otherwise fail and call the match a stall.
+    if (stall_reference < MATCH_TOLERANCE_REL * result.bbox_diag_mm) {
+      stop_with(result, DesignStop::Matched, matched_message());
+      return m_driver.finish(result, rest);
     }
     Eigen::VectorXd gradient;
     double objective = m_objective.value(rest, m_x);
@@ -236,8 +248,7 @@ class ReducedSpaceDesign {
       const double relative_decrease = -t * slope / std::max(initial_objective, 1e-300);
       small_decreases = relative_decrease < 1e-7 ? small_decreases + 1 : 0;
       if (stats.avg_rel < MATCH_TOLERANCE_REL) {
-        stop_with(result, DesignStop::Matched, "matched: the inflated shape matches the target to " +
-                                                   format_fraction(MATCH_TOLERANCE_REL) + " of its bounding-box diagonal");
+        stop_with(result, DesignStop::Matched, matched_message());
         break;
       }
       if (objective <= 1e-14 * initial_objective || gradient.norm() <= OPTIMALITY_TOLERANCE * initial_gradient_norm) {

@@ -223,6 +223,22 @@ TEST(BalloonDesign, ADesignStoppedBeforeItsStartInflatedHasNoErrors) {
   EXPECT_FALSE(design.residual_norm.has_value());
 }
 
+TEST(BalloonDesign, AStartThatAlreadyMatchesIsMatchedNotStalled) {
+  // A regular icosahedron (12 vertices) inflates onto itself by symmetry: the baseline is the answer. It
+  // was reported `stalled` (no decrease along the steepest descent) with both errors at 4e-15 mm.
+  const TriMesh icosahedron = make_icosphere(50.0, 0);
+  ASSERT_EQ(icosahedron.vertex_count(), 12);
+  DesignOptions options;
+  options.material = *parse_material_spec("silicone");
+  const DesignResult design = design_balloon(icosahedron, options);
+  EXPECT_EQ(design.stop, DesignStop::Matched) << design_stop_name(design.stop) << ": " << design.message;
+  EXPECT_TRUE(design.converged) << design.message;
+  EXPECT_EQ(design.iterations, 0);
+  ASSERT_TRUE(design.avg_error_mm && design.baseline_avg_error_mm);
+  EXPECT_LT(*design.avg_error_mm, 1e-4 * bounding_box_diagonal(icosahedron.vertices));  // the match tolerance
+  EXPECT_EQ(*design.avg_error_mm, *design.baseline_avg_error_mm);
+}
+
 TEST(BalloonDesign, AStalledDesignIsNotCalledConverged) {
   // A box with flat faces and sharp edges: no inflated membrane matches it, so the design improves on
   // the start, then stops improving. That is a stall, reported as one, never as convergence.
