@@ -41,7 +41,7 @@ namespace {
 std::string options_problem(const TriMesh& target, const DesignOptions& options) {
   if (target.vertex_count() < 4 || target.face_count() < 4) return "the target mesh is empty";
   if (auto problem = material_problem(options.material); !problem.empty()) return problem;
-  if (!(options.thickness_mm > 0.0) || !std::isfinite(options.thickness_mm)) return "thickness must be positive (mm)";
+  if (auto problem = thickness_problem(options.thickness_mm); !problem.empty()) return problem;
   if (options.scale > 0) {
     if (!(options.scale < 1.0)) return "scale must be below 1: the balloon starts smaller than the target";
   } else if (!(options.volume_ratio > 1.0) || !std::isfinite(options.volume_ratio)) {

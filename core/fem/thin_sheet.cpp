@@ -5,6 +5,14 @@
 
 namespace balloon {
 
+std::string thickness_problem(double thickness_mm) {
+  if (std::isfinite(thickness_mm) && thickness_mm >= MIN_THICKNESS_MM) return "";
+  std::ostringstream out;
+  out << "thickness must be a positive number of mm, at least " << MIN_THICKNESS_MM << " (a micrometre), got "
+      << thickness_mm;
+  return out.str();
+}
+
 std::string thin_sheet_problem(double thickness_mm, double rest_diagonal_mm) {
   // 10% is the model's rule of thumb, not a sharp edge, so it has 2% slack: a design target is checked at
   // the size the user gave, and its remeshed surface, which lies inside the given one, is a little smaller

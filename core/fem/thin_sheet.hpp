@@ -16,4 +16,11 @@ constexpr double THIN_SHEET_SLACK = 0.02;
 /// not a thin sheet, naming both sizes and the remedy; "" when it is one.
 std::string thin_sheet_problem(double thickness_mm, double rest_diagonal_mm);
 
+/// The thinnest sheet simulated (mm): a micrometre, far below any rubber sheet. Far below it the forces
+/// vanish in rounding (at 1e-300 mm every shape "balanced" at zero pressure: converged in 0 Newton steps).
+constexpr double MIN_THICKNESS_MM = 1e-3;
+
+/// Why `thickness_mm` is no sheet thickness (not a finite number of at least MIN_THICKNESS_MM), or "".
+std::string thickness_problem(double thickness_mm);
+
 }  // namespace balloon

@@ -724,12 +724,12 @@ std::string options_problem(const TriMesh& rest, const InflationOptions& options
   if (!rest.vertices.allFinite()) return "the rest mesh has non-finite coordinates";
   if (auto problem = material_problem(options.material); !problem.empty()) return problem;
   if (options.element_thickness_mm.empty()) {
-    if (!(options.thickness_mm > 0.0) || !std::isfinite(options.thickness_mm)) return "thickness must be positive (mm)";
+    if (auto problem = thickness_problem(options.thickness_mm); !problem.empty()) return problem;
   } else {
     if (static_cast<int>(options.element_thickness_mm.size()) != rest.face_count())
       return "per-triangle thickness needs one value per triangle";
     for (double h : options.element_thickness_mm)
-      if (!(h > 0.0) || !std::isfinite(h)) return "per-triangle thickness must be positive (mm)";
+      if (auto problem = thickness_problem(h); !problem.empty()) return "per-triangle " + problem;
   }
   const double thickest = options.element_thickness_mm.empty()
                               ? options.thickness_mm

@@ -70,8 +70,8 @@ DesignOutcome& find_mold(const DesignInput& input, DesignOutcome& outcome) {
 std::vector<FieldProblem> design_parameter_problems(const DesignParameters& parameters) {
   std::vector<FieldProblem> problems;
   const auto problem = [&](const char* field, std::string message) { problems.push_back({field, std::move(message)}); };
-  if (!std::isfinite(parameters.thickness_mm) || parameters.thickness_mm <= 0.0)
-    problem("thickness_mm", "thickness must be a positive number of mm, got " + format_number(parameters.thickness_mm));
+  if (std::string thickness = thickness_problem(parameters.thickness_mm); !thickness.empty())
+    problem("thickness_mm", std::move(thickness));
   if (std::string size = size_mm_problem(parameters.size_mm); !size.empty()) problem("size_mm", std::move(size));
   if (parameters.resolution < 0)
     problem("resolution", "resolution must be >= 0 vertices (0 never remeshes)");
@@ -82,13 +82,15 @@ std::vector<FieldProblem> design_parameter_problems(const DesignParameters& para
   // here rather than failing deep in the solver (a start shrunk to nothing has zero-length edges).
   if (parameters.scale && parameters.volume_ratio)
     problem("scale", "give either a scale or a volume ratio, not both");
-  else if (parameters.scale && (!std::isfinite(*parameters.scale) || *parameters.scale < std::cbrt(1.0 / MAX_VOLUME_RATIO)))
+  // The start is the target shrunk (scale below 1, volume ratio above 1): the balloon inflates into it.
+  else if (parameters.scale &&
+           (!std::isfinite(*parameters.scale) || *parameters.scale < std::cbrt(1.0 / MAX_VOLUME_RATIO) || *parameters.scale >= 1.0))
     problem("scale", "scale must be a number of at least " + format_number(std::cbrt(1.0 / MAX_VOLUME_RATIO)) +
-                         ", got " + format_number(*parameters.scale));
+                         " and below 1, got " + format_number(*parameters.scale));
   else if (parameters.volume_ratio &&
-           (!std::isfinite(*parameters.volume_ratio) || *parameters.volume_ratio <= 0.0 ||
+           (!std::isfinite(*parameters.volume_ratio) || *parameters.volume_ratio <= 1.0 ||
             *parameters.volume_ratio > MAX_VOLUME_RATIO))
-    problem("volume_ratio", "volume ratio must be a positive number up to " + format_number(MAX_VOLUME_RATIO) +
+    problem("volume_ratio", "volume ratio must be a positive number above 1 and up to " + format_number(MAX_VOLUME_RATIO) +
                                 ", got " + format_number(*parameters.volume_ratio));
   if (!parameters.method.empty()) {
     Result<DesignMethod> method = parse_design_method(parameters.method);

@@ -22,8 +22,8 @@ std::string format_number(double value, const char* format = "%.6g") {
 
 std::vector<FieldProblem> simulate_parameter_problems(const SimulateParameters& parameters) {
   std::vector<FieldProblem> problems;
-  if (!std::isfinite(parameters.thickness_mm) || parameters.thickness_mm <= 0.0)
-    problems.push_back({"thickness_mm", "thickness must be a positive number of mm, got " + format_number(parameters.thickness_mm)});
+  if (std::string thickness = thickness_problem(parameters.thickness_mm); !thickness.empty())
+    problems.push_back({"thickness_mm", std::move(thickness)});
   if (std::string size = size_mm_problem(parameters.size_mm); !size.empty()) problems.push_back({"size_mm", std::move(size)});
   const int controls = (parameters.pressure_kpa ? 1 : 0) + (parameters.volume_ratio ? 1 : 0) + (parameters.curve ? 1 : 0);
   if (controls > 1)

@@ -446,8 +446,8 @@ TEST(HostileInputs, CatalogueGetsItsStatusesAndTheServerStaysServingAndSmall) {
                 v == 0.0 ? "" : "size must be a number of mm up to");
     v1::SubmitJobRequest scale = good_design();
     scale.mutable_spec()->mutable_design()->set_scale(v);
-    submit_case("design scale " + number_name(v), scale, v == 1e308 ? StatusCode::OK : StatusCode::INVALID_ARGUMENT,
-                v == 1e308 ? "" : "scale must be a number of at least");
+    // 1e308 is no start: the balloon must start smaller than its target (it ended start_failed in the job).
+    submit_case("design scale " + number_name(v), scale, StatusCode::INVALID_ARGUMENT, "scale must be a number of at least");
     v1::SubmitJobRequest ratio = good_design();
     ratio.mutable_spec()->mutable_design()->set_volume_ratio(v);
     // 1e308 is refused at submit: no rubber inflates past 1000-fold (it failed deep in the solver before).
@@ -459,6 +459,22 @@ TEST(HostileInputs, CatalogueGetsItsStatusesAndTheServerStaysServingAndSmall) {
     submit_case("design max_time_s " + number_name(v), time, time_valid ? StatusCode::OK : StatusCode::INVALID_ARGUMENT,
                 time_valid ? "" : "max time must be a number of s >= 0");
   }
+  // A sheet far thinner than any rubber (1e-300 mm "converged" in 0 Newton steps: every force rounded to 0),
+  // a start no smaller than its target (scale 1, volume ratio 1): refused at submit, not failed in the job.
+  for (const double thin : {1e-300, 9e-4}) {
+    v1::SubmitJobRequest simulate = good_simulate();
+    simulate.mutable_spec()->mutable_simulate()->set_thickness_mm(thin);
+    submit_case("simulate thickness_mm " + std::to_string(thin), simulate, StatusCode::INVALID_ARGUMENT, "at least 0.001");
+    v1::SubmitJobRequest design = good_design();
+    design.mutable_spec()->mutable_design()->set_thickness_mm(thin);
+    submit_case("design thickness_mm " + std::to_string(thin), design, StatusCode::INVALID_ARGUMENT, "at least 0.001");
+  }
+  v1::SubmitJobRequest unit_scale = good_design();
+  unit_scale.mutable_spec()->mutable_design()->set_scale(1.0);
+  submit_case("design scale 1", unit_scale, StatusCode::INVALID_ARGUMENT, "below 1");
+  v1::SubmitJobRequest unit_ratio = good_design();
+  unit_ratio.mutable_spec()->mutable_design()->set_volume_ratio(1.0);
+  submit_case("design volume_ratio 1", unit_ratio, StatusCode::INVALID_ARGUMENT, "above 1");
   for (const int v : {0, -1, 49, std::numeric_limits<int>::max(), std::numeric_limits<int>::min()}) {
     v1::SubmitJobRequest resolution = good_design();
     resolution.mutable_spec()->mutable_design()->set_resolution(v);
