@@ -111,16 +111,24 @@ std::string material_problem(const Material& material) {
     if (!std::isfinite(material.params[i])) return "material parameter " + names[i] + " is not a finite number";
   }
   const auto& p = material.params;
+  // A leading modulus outside 1 Pa .. 100 GPa is no rubber's, and far outside it the forces round to 0 or
+  // overflow (mu = 1e-300 MPa: every shape "balanced" at once, converged after 0 Newton steps). A second
+  // modulus (C2) may be anything from 0 up: a fit drives an unneeded one towards 0, not to it.
+  const auto modulus_problem = [](const std::string& name, double value, bool leading) -> std::string {
+    if ((leading ? value >= MIN_MODULUS_MPA : value >= 0.0) && value <= MAX_MODULUS_MPA) return "";
+    std::ostringstream out;
+    out << "material parameter " << name << " must be a modulus from " << (leading ? MIN_MODULUS_MPA : 0.0) << " to "
+        << MAX_MODULUS_MPA << " MPa (" << (leading ? "1 Pa" : "0") << " to 100 GPa), got " << value;
+    return out.str();
+  };
   switch (material.model) {
     case MaterialModel::NeoHookean:
-      if (p[0] <= 0) return "material parameter mu must be positive (MPa)";
-      break;
+      return modulus_problem("mu", p[0], true);
     case MaterialModel::MooneyRivlin:
-      if (p[0] <= 0) return "material parameter C1 must be positive (MPa)";
-      if (p[1] < 0) return "material parameter C2 must be non-negative (MPa)";
-      break;
+      if (auto problem = modulus_problem("C1", p[0], true); !problem.empty()) return problem;
+      return modulus_problem("C2", p[1], false);
     case MaterialModel::HartSmith:
-      if (p[0] <= 0) return "material parameter G must be positive (MPa)";
+      if (auto problem = modulus_problem("G", p[0], true); !problem.empty()) return problem;
       if (p[1] < 0) return "material parameter k1 must be non-negative";
       if (p[2] < 0) return "material parameter k2 must be non-negative";
       break;

@@ -42,7 +42,11 @@ std::vector<std::string> parameter_names(MaterialModel model);
 /// Parses a model name; fails with a message listing the known models.
 Result<MaterialModel> parse_model_name(const std::string& name);
 
-/// Parses `model:name=value,...` (every parameter required, positive moduli, k1 >= 0, k2 >= 0),
+/// The leading modulus (mu, C1, G) a material may have (MPa): 1 Pa to 100 GPa (C2: 0 to 100 GPa).
+constexpr double MIN_MODULUS_MPA = 1e-6;
+constexpr double MAX_MODULUS_MPA = 1e5;
+
+/// Parses `model:name=value,...` (every parameter required, moduli within the bounds above, k1 >= 0, k2 >= 0),
 /// or a preset name (`silicone`, `latex`).
 Result<Material> parse_material_spec(const std::string& spec);
 /// Checks that the constants are finite and physical; returns an empty string when they are.
