@@ -459,6 +459,9 @@ void JobHandler::run_job(std::int64_t row_id) {
       RunContext context{*record, spec, active->token, progress_publisher(*record, spec, &flush_progress),
                          [this, &record](const Faces& faces) { m_watches.set_connectivity(record->job_id, faces); },
                          m_materials, m_jobs.design_checkpoint(record->row_id), std::move(prepared)};
+      if (time_limit_s > 0.0)
+        context.deadline = active->started + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                 std::chrono::duration<double>(time_limit_s));
       RunOutcome outcome = kind->run(context);
       flush_progress();  // the last rows before the outcome, so a finished job has all of them
       finish_run(*record, *kind, *active, std::move(outcome));

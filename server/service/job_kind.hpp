@@ -2,6 +2,7 @@
 /// One kind of job (simulate, design, fit_material): how its request is checked at submit, described,
 /// run on a worker and returned as a result. Adding a kind touches one implementation file and the
 /// list in job_kinds.cpp; the handler, the pool and the watch hub do not change.
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -49,6 +50,8 @@ struct RunContext {
   std::optional<std::pair<int, std::string>> design_checkpoint = std::nullopt;
   /// What check() prepared for this job at submit in this process (CheckedJob::prepared), or null.
   std::shared_ptr<const void> prepared = nullptr;
+  /// When the job's time limit stops it (the cancel token fires then), if it has one.
+  std::optional<std::chrono::steady_clock::time_point> deadline = std::nullopt;
 };
 
 /// How a run ended. The handler records it: one path for each outcome.

@@ -255,6 +255,47 @@ TEST(ServiceJobs, DesignJobStreamsIntermediateMeshesAndReturnsAReport) {
   EXPECT_EQ(inflated->vertex_count(), 162);
 }
 
+TEST(ServiceJobs, ADesignAtItsJobTimeLimitKeepsItsBestDesign) {
+  // The job's time limit (not the design's own max_time_s) used to cancel the optimizer mid-iteration and
+  // fail the job with nothing kept. Now the optimizer gets the limit as its budget, less time to build the
+  // mold and report, and the job completes with the best design found, `time_limit`, not converged.
+  ScratchDir scratch;
+  ServerProcess server(scratch.file("jobs.db"), {"--workers", "1"});
+  auto stub = server.stub();
+  v1::SubmitJobRequest request;
+  v1::DesignJob* job = request.mutable_spec()->mutable_design();
+  TriMesh box = make_icosphere(20.0, 2);  // flat faces no inflated sheet matches: it would run on
+  box.vertices = box.vertices.cwiseMax(-12.0).cwiseMin(12.0);
+  job->mutable_target_mesh()->set_data(write_mesh_to_memory(box, "obj"));
+  job->mutable_target_mesh()->set_format(v1::MESH_FORMAT_OBJ);
+  job->mutable_material()->set_name("silicone");
+  job->set_resolution(2000);  // remeshed on the worker, within the limit
+  request.mutable_spec()->set_time_limit_s(5.0);
+  std::string job_id;
+  const grpc::Status submitted = submit_job(*stub, request, &job_id);
+  ASSERT_TRUE(submitted.ok()) << submitted.error_message();
+  grpc::Status status;
+  const std::vector<v1::JobEvent> events = watch_all(*stub, job_id, &status);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_FALSE(events.empty());
+  ASSERT_EQ(events.back().state(), v1::JOB_STATE_COMPLETED) << events.back().message();
+
+  grpc::ClientContext result_context;
+  v1::GetResultRequest result_request;
+  result_request.set_job_id(job_id);
+  v1::JobResult result;
+  const grpc::Status got = stub->GetResult(&result_context, result_request, &result);
+  ASSERT_TRUE(got.ok()) << got.error_message();
+  const v1::DesignReport& report = result.design_report();
+  EXPECT_EQ(report.stop_reason(), "time_limit") << report.message();
+  EXPECT_FALSE(report.converged());
+  EXPECT_GE(report.iterations(), 1);
+  EXPECT_LT(report.time_s(), 5.0);
+  ASSERT_TRUE(report.has_avg_error_mm() && report.has_baseline_avg_error_mm());
+  EXPECT_LT(report.avg_error_mm(), report.baseline_avg_error_mm());
+  EXPECT_FALSE(result.rest_mesh().data().empty());
+}
+
 }  // namespace
 }  // namespace balloon::testing
 
