@@ -1,4 +1,5 @@
 /// `balloon mesh sphere`: write an icosphere, the analytic test balloon.
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 
@@ -7,6 +8,7 @@
 #include "commands.hpp"
 #include "exit_codes.hpp"
 #include "jobs/json_writer.hpp"
+#include "jobs/mesh_size.hpp"
 #include "mesh/icosphere.hpp"
 
 namespace balloon::cli {
@@ -50,7 +52,15 @@ int run_mesh_command(const std::vector<std::string>& args, const GlobalOptions& 
   if (!radius_text) return report_error(COMMAND, "missing --radius MM", EXIT_BAD_INPUT);
   Result<double> radius = parse_number("radius", *radius_text);
   if (!radius) return report_error(COMMAND, radius.error(), EXIT_BAD_INPUT);
-  if (*radius <= 0.0) return report_error(COMMAND, "--radius must be positive (mm), got " + *radius_text, EXIT_BAD_INPUT);
+  // Its bounding-box diagonal (2 sqrt(3) radii) within any mesh's size limit: a larger one is refused at
+  // every upload, so it is no use writing it (--radius 1e300 wrote coordinates of 1e299 mm).
+  const double max_radius_mm = jobs::MAX_SIZE_MM / (2.0 * std::sqrt(3.0));
+  if (!(*radius > 0.0 && *radius <= max_radius_mm)) {
+    char limit[32];
+    std::snprintf(limit, sizeof(limit), "%.6g", max_radius_mm);
+    return report_error(COMMAND, "--radius must be positive and at most " + std::string(limit) + " mm, got " + *radius_text,
+                        EXIT_BAD_INPUT);
+  }
 
   const auto subdivisions_text = parsed->get("subdivisions");
   if (!subdivisions_text) return report_error(COMMAND, "missing --subdivisions K", EXIT_BAD_INPUT);

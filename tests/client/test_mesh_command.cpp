@@ -31,6 +31,7 @@ TEST(MeshCommand, RejectsBadArguments) {
   const std::string out = scratch.file("s.obj");
   for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{
            {"mesh", "sphere", "--radius", "-1", "--subdivisions", "2", "--out", out},
+           {"mesh", "sphere", "--radius", "1e300", "--subdivisions", "2", "--out", out},  // beyond any mesh's size limit
            {"mesh", "sphere", "--radius", "1", "--subdivisions", "9", "--out", out},
            {"mesh", "sphere", "--radius", "1", "--subdivisions", "1.5", "--out", out},
            {"mesh", "sphere", "--radius", "1", "--subdivisions", "2"},
