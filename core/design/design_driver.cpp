@@ -281,7 +281,7 @@ void DesignDriver::remember_if_best(const Eigen::VectorXd& rest, double avg_erro
   m_best_pressure = m_pressure;
 }
 
-void DesignDriver::restore_best(Eigen::VectorXd& rest) {
+bool DesignDriver::restore_best(Eigen::VectorXd& rest) {
   // E_dist and the surface error mostly fall together; where they part, hand back the design with
   // the smallest average surface error seen (the log still shows every iterate).
   if (m_best_error < std::numeric_limits<double>::infinity() && m_best_rest.size() == rest.size()) {
@@ -290,8 +290,10 @@ void DesignDriver::restore_best(Eigen::VectorXd& rest) {
       rest = m_best_rest;
       m_x = m_best_x;
       m_pressure = m_best_pressure;
+      return true;
     }
   }
+  return false;
 }
 
 DesignResult& DesignDriver::finish(DesignResult& result, const Eigen::VectorXd& rest) {

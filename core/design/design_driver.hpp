@@ -85,8 +85,9 @@ class DesignDriver {
   void record(DesignResult& result, int iteration, const SurfaceDistanceStats& stats, const Eigen::VectorXd& rest);
   /// Keeps (rest, x, pressure) when `avg_error` is the smallest seen.
   void remember_if_best(const Eigen::VectorXd& rest, double avg_error);
-  /// Goes back to the best design seen when its average surface error is below the current one's.
-  void restore_best(Eigen::VectorXd& rest);
+  /// Goes back to the best design seen when its average surface error is below the current one's; true
+  /// when it did.
+  bool restore_best(Eigen::VectorXd& rest);
   /// Whether the returned shape is an equilibrium (alm: whether its final re-inflation converged).
   void set_final_equilibrium(bool converged) { m_final_equilibrium = converged; }
   /// The result's shapes and errors. Without an inflated start (start_failed, or stopped before it)
