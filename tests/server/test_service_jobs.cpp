@@ -49,26 +49,32 @@ grpc::Status submit_job(v1::BalloonService::Stub& stub, const v1::SubmitJobReque
   return status;
 }
 
+/// Submits `request`, follows it to its end, which must be COMPLETED, and fetches its result.
+::testing::AssertionResult run_to_result(v1::BalloonService::Stub& stub, const v1::SubmitJobRequest& request,
+                                         v1::JobResult* result) {
+  std::string job_id;
+  const grpc::Status submitted = submit_job(stub, request, &job_id);
+  if (!submitted.ok()) return ::testing::AssertionFailure() << "submit: " << submitted.error_message();
+  grpc::Status status;
+  const std::vector<v1::JobEvent> events = watch_all(stub, job_id, &status);
+  if (!status.ok()) return ::testing::AssertionFailure() << "watch: " << status.error_message();
+  if (events.empty() || events.back().state() != v1::JOB_STATE_COMPLETED)
+    return ::testing::AssertionFailure() << "not completed: " << (events.empty() ? "no events" : events.back().message());
+  grpc::ClientContext context;
+  v1::GetResultRequest result_request;
+  result_request.set_job_id(job_id);
+  const grpc::Status got = stub.GetResult(&context, result_request, result);
+  if (!got.ok()) return ::testing::AssertionFailure() << "result: " << got.error_message();
+  return ::testing::AssertionSuccess();
+}
+
 TEST(ServiceJobs, FitJobFitsTreloarStoresTheMaterialAndReturnsTheReport) {
   ScratchDir scratch;
   ServerProcess server(scratch.file("jobs.db"), {"--workers", "1"});
   auto stub = server.stub();
 
-  std::string job_id;
-  const grpc::Status submitted = submit_job(*stub, treloar_fit_request("hart-smith", "treloar-hs"), &job_id);
-  ASSERT_TRUE(submitted.ok()) << submitted.error_message();
-  grpc::Status status;
-  const std::vector<v1::JobEvent> events = watch_all(*stub, job_id, &status);
-  ASSERT_TRUE(status.ok()) << status.error_message();
-  ASSERT_FALSE(events.empty());
-  ASSERT_EQ(events.back().state(), v1::JOB_STATE_COMPLETED) << events.back().message();
-
-  grpc::ClientContext result_context;
-  v1::GetResultRequest result_request;
-  result_request.set_job_id(job_id);
   v1::JobResult result;
-  const grpc::Status got = stub->GetResult(&result_context, result_request, &result);
-  ASSERT_TRUE(got.ok()) << got.error_message();
+  ASSERT_TRUE(run_to_result(*stub, treloar_fit_request("hart-smith", "treloar-hs"), &result));
   EXPECT_EQ(result.kind(), v1::JOB_KIND_FIT_MATERIAL);
   EXPECT_TRUE(result.rest_mesh().data().empty()) << "a fit has no meshes";
   ASSERT_TRUE(result.has_fit_report());
@@ -271,21 +277,8 @@ TEST(ServiceJobs, ADesignAtItsJobTimeLimitKeepsItsBestDesign) {
   job->mutable_material()->set_name("silicone");
   job->set_resolution(2000);  // remeshed on the worker, within the limit
   request.mutable_spec()->set_time_limit_s(5.0);
-  std::string job_id;
-  const grpc::Status submitted = submit_job(*stub, request, &job_id);
-  ASSERT_TRUE(submitted.ok()) << submitted.error_message();
-  grpc::Status status;
-  const std::vector<v1::JobEvent> events = watch_all(*stub, job_id, &status);
-  ASSERT_TRUE(status.ok()) << status.error_message();
-  ASSERT_FALSE(events.empty());
-  ASSERT_EQ(events.back().state(), v1::JOB_STATE_COMPLETED) << events.back().message();
-
-  grpc::ClientContext result_context;
-  v1::GetResultRequest result_request;
-  result_request.set_job_id(job_id);
   v1::JobResult result;
-  const grpc::Status got = stub->GetResult(&result_context, result_request, &result);
-  ASSERT_TRUE(got.ok()) << got.error_message();
+  ASSERT_TRUE(run_to_result(*stub, request, &result));
   const v1::DesignReport& report = result.design_report();
   EXPECT_EQ(report.stop_reason(), "time_limit") << report.message();
   EXPECT_FALSE(report.converged());

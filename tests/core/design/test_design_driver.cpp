@@ -9,12 +9,19 @@
 namespace balloon {
 namespace {
 
-TEST(DesignDriver, SwitchingBendingOnKeepsAnEquilibriumAndListsTheTerm) {
-  const TriMesh target = design_test::inflated_ellipsoid_target(2, 1.0);
+/// Silicone to x6 on the smooth ellipsoid every test here starts from.
+DesignOptions ellipsoid_options(DesignMethod method) {
   DesignOptions options;
   options.material = *parse_material_spec("silicone");
   options.volume_ratio = 6.0;
-  DesignDriver driver(target, options);
+  options.method = method;
+  return options;
+}
+
+TEST(DesignDriver, SwitchingBendingOnKeepsAnEquilibriumAndListsTheTerm) {
+  const TriMesh target = design_test::inflated_ellipsoid_target(2, 1.0);
+  const DesignOptions options = ellipsoid_options(DesignMethod::Adjoint);
+  DesignDriver driver(target, options);  // keeps a reference to both
   DesignResult result = driver.begin(DesignMethod::Adjoint);
   const Eigen::VectorXd rest = flat(driver.start().vertices);
   ASSERT_TRUE(driver.inflate_start(rest, result)) << result.message;
@@ -36,10 +43,7 @@ TEST(DesignDriver, SwitchingBendingOnKeepsAnEquilibriumAndListsTheTerm) {
 
 TEST(DesignDriver, TheAugmentedLagrangianKeepsAMembrane) {
   const TriMesh target = design_test::inflated_ellipsoid_target(2, 1.0);
-  DesignOptions options;
-  options.material = *parse_material_spec("silicone");
-  options.volume_ratio = 6.0;
-  options.method = DesignMethod::AugmentedLagrangian;
+  const DesignOptions options = ellipsoid_options(DesignMethod::AugmentedLagrangian);
   DesignDriver driver(target, options);
   DesignResult result = driver.begin(DesignMethod::AugmentedLagrangian);
   const Eigen::VectorXd rest = flat(driver.start().vertices);
@@ -52,9 +56,7 @@ TEST(DesignDriver, RestoreBestHandsBackTheStartWhenTheCurrentShapeIsFartherFromT
   // What both optimizers end with: the augmented Lagrangian's final equilibrium can inflate farther from
   // the target than its start (cactus, latex, 10 s: 3.22 mm against 3.10 mm); the start comes back then.
   const TriMesh target = design_test::inflated_ellipsoid_target(2, 1.0);
-  DesignOptions options;
-  options.material = *parse_material_spec("silicone");
-  options.volume_ratio = 6.0;
+  const DesignOptions options = ellipsoid_options(DesignMethod::AugmentedLagrangian);
   DesignDriver driver(target, options);
   DesignResult result = driver.begin(DesignMethod::AugmentedLagrangian);
   const Eigen::VectorXd start = flat(driver.start().vertices);
