@@ -113,7 +113,7 @@ std::string material_problem(const Material& material) {
   const auto& p = material.params;
   // A leading modulus outside 1 Pa .. 100 GPa is no rubber's, and far outside it the forces round to 0 or
   // overflow (mu = 1e-300 MPa: every shape "balanced" at once, converged after 0 Newton steps). A second
-  // modulus (C2) may be anything from 0 up: a fit drives an unneeded one towards 0, not to it.
+  // modulus (C2) has no lower bound but 0: a fit drives an unneeded one towards 0, not to it.
   const auto modulus_problem = [](const std::string& name, double value, bool leading) -> std::string {
     if ((leading ? value >= MIN_MODULUS_MPA : value >= 0.0) && value <= MAX_MODULUS_MPA) return "";
     std::ostringstream out;
