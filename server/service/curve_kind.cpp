@@ -43,6 +43,7 @@ class CurveKind final : public JobKind {
     jobs::RunControls controls;
     controls.cancel = &context.cancel;
     controls.progress = context.progress;
+    controls.max_time_s = run_budget_s(context);
     const PressureVolumeCurve curve = jobs::run_curve(input, controls);
     if (context.cancel.cancelled()) return RunOutcome::stopped();
     store::ResultRecord result;

@@ -16,11 +16,6 @@ namespace {
 
 namespace v1 = balloon::v1;
 
-/// Time kept after a time-limited design's optimizer stops, for the mold and the report (s): a tenth of
-/// what is left, within these bounds.
-constexpr double DESIGN_FINISH_MIN_S = 1.0;
-constexpr double DESIGN_FINISH_MAX_S = 30.0;
-
 /// prepare_target's smallest resolution (vertices) other than 0.
 constexpr int MIN_REMESH_RESOLUTION = 100;
 
@@ -137,16 +132,6 @@ std::optional<DesignCheckpoint> checkpoint_of(const RunContext& context) {
   return DesignCheckpoint{rest->vertices, context.design_checkpoint->first};
 }
 
-/// The optimizer's budget (s) under a job time limit: it stops itself that long before the limit, keeping
-/// the best design (`time_limit`), with time left for the mold and the report. Otherwise the limit's
-/// cancel stopped it mid-iteration and the job failed with nothing kept. 0: no limit.
-double design_budget_s(const std::optional<std::chrono::steady_clock::time_point>& deadline) {
-  if (!deadline) return 0.0;
-  const double left_s = std::chrono::duration<double>(*deadline - std::chrono::steady_clock::now()).count();
-  const double margin_s = std::clamp(0.1 * left_s, DESIGN_FINISH_MIN_S, DESIGN_FINISH_MAX_S);
-  return std::max(left_s - margin_s, DESIGN_FINISH_MIN_S);
-}
-
 class DesignKind final : public JobKind {
  public:
   const char* name() const override { return "design"; }
@@ -177,7 +162,7 @@ class DesignKind final : public JobKind {
     jobs::RunControls controls;
     controls.cancel = &context.cancel;
     controls.progress = context.progress;
-    controls.max_time_s = design_budget_s(context.deadline);
+    controls.max_time_s = run_budget_s(context);
     const jobs::DesignOutcome outcome = jobs::run_design(input, controls, checkpoint_of(context));
     if (context.cancel.cancelled()) return RunOutcome::stopped();
     if (outcome.result.rest.vertex_count() == 0)

@@ -103,6 +103,11 @@ ServiceStatus read_uploaded_mesh(const balloon::v1::MeshFile& file, const std::s
 /// INVALID_ARGUMENT with one field violation per problem (paths as the job layer names them, relative to
 /// the job message); the message is the first problem's. `problems` is not empty.
 ServiceStatus bad_fields(const std::vector<jobs::FieldProblem>& problems);
+/// A run's own time budget (s) under its job's time limit, for RunControls::max_time_s: the time left
+/// less a tenth of it (1 to 30 s) for the results and the report, so that the run stops itself and hands
+/// back what it has (a design its best design, a simulation its last equilibrium, a curve its points so
+/// far) instead of being cancelled at the limit and failed with nothing kept. 0 without a limit.
+double run_budget_s(const RunContext& context);
 /// "%g" of a number.
 std::string format_number(double value);
 /// A measured duration as people read it: 0.0123 -> "0.01", 5.76272 -> "5.76", 123.456 -> "123.5" (s).

@@ -2,6 +2,7 @@
 #include <google/protobuf/util/json_util.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 
 #include "jobs/design_job.hpp"
@@ -14,6 +15,11 @@ namespace balloon::service {
 namespace v1 = balloon::v1;
 
 namespace {
+
+/// Time kept after a time-limited run stops itself, for its results and report (s): a tenth of what is
+/// left, within these bounds.
+constexpr double RUN_FINISH_MIN_S = 1.0;
+constexpr double RUN_FINISH_MAX_S = 30.0;
 
 /// The kind's report message inside `reply`, selected in the `report` oneof.
 google::protobuf::Message* report_of(v1::JobKind kind, v1::JobResult* reply) {
@@ -145,6 +151,13 @@ ServiceStatus bad_fields(const std::vector<jobs::FieldProblem>& problems) {
   std::vector<FieldViolation> violations;
   for (const jobs::FieldProblem& problem : problems) violations.push_back({problem.field, problem.message});
   return ServiceStatus::bad_fields(std::move(violations));
+}
+
+double run_budget_s(const RunContext& context) {
+  if (!context.deadline) return 0.0;
+  const double left_s = std::chrono::duration<double>(*context.deadline - std::chrono::steady_clock::now()).count();
+  const double margin_s = std::clamp(0.1 * left_s, RUN_FINISH_MIN_S, RUN_FINISH_MAX_S);
+  return std::max(left_s - margin_s, RUN_FINISH_MIN_S);
 }
 
 std::string format_number(double value) {

@@ -104,6 +104,7 @@ class SimulateKind final : public JobKind {
     jobs::RunControls controls;
     controls.cancel = &context.cancel;
     controls.progress = context.progress;
+    controls.max_time_s = run_budget_s(context);
     const jobs::SimulateOutcome outcome = jobs::run_simulate(input, controls);
     if (context.cancel.cancelled()) return RunOutcome::stopped();
     store::ResultRecord result;

@@ -289,6 +289,39 @@ TEST(ServiceJobs, ADesignAtItsJobTimeLimitKeepsItsBestDesign) {
   EXPECT_FALSE(result.rest_mesh().data().empty());
 }
 
+TEST(ServiceJobs, ASimulationAndACurveAtTheirJobTimeLimitKeepWhatTheyReached) {
+  // The knot with Mooney-Rivlin x8 at 100 mm runs for a minute (a bulge running along its tube). Cut at its
+  // job time limit, a simulation used to fail with nothing kept; it now completes, not converged, at
+  // `time_limit`, and a curve keeps the points it reached.
+  ScratchDir scratch;
+  ServerProcess server(scratch.file("jobs.db"), {"--workers", "1"});
+  auto stub = server.stub();
+  v1::SubmitJobRequest request;
+  v1::SimulateJob* job = request.mutable_spec()->mutable_simulate();
+  job->mutable_rest_mesh()->set_data(read_text(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/knot.off"));
+  job->mutable_rest_mesh()->set_format(v1::MESH_FORMAT_OFF);
+  job->mutable_material()->set_spec("mooney-rivlin:C1=0.139679,C2=0.0280028");
+  job->set_size_mm(100.0);
+  job->set_volume_ratio(8.0);
+  request.mutable_spec()->set_time_limit_s(4.0);
+  v1::JobResult result;
+  ASSERT_TRUE(run_to_result(*stub, request, &result));
+  EXPECT_EQ(result.simulate_report().stop_reason(), "time_limit") << result.simulate_report().message();
+  EXPECT_FALSE(result.simulate_report().converged());
+  EXPECT_LT(result.simulate_report().time_s(), 4.0);
+
+  job->clear_volume_ratio();
+  job->mutable_curve()->mutable_volume_ratio_range()->set_from(1.5);
+  job->mutable_curve()->mutable_volume_ratio_range()->set_to(8.0);
+  job->mutable_curve()->set_points(10);
+  ASSERT_TRUE(run_to_result(*stub, request, &result));
+  const v1::CurveReport& curve = result.curve_report();
+  EXPECT_EQ(curve.stop_reason(), "time_limit") << curve.message();
+  ASSERT_EQ(curve.points_size(), 10);
+  EXPECT_TRUE(curve.points(0).converged()) << "the first point (x1.5) takes well under a second";
+  EXPECT_FALSE(curve.points(9).converged());
+}
+
 }  // namespace
 }  // namespace balloon::testing
 
