@@ -129,7 +129,15 @@ std::string material_problem(const Material& material) {
       return modulus_problem("C2", p[1], false);
     case MaterialModel::HartSmith:
       if (auto problem = modulus_problem("G", p[0], true); !problem.empty()) return problem;
-      if (p[1] < 0) return "material parameter k1 must be non-negative";
+      // exp(k1 (I1 - 3)^2): far above the fits (3e-4 to 0.03) it overflows at once (k1 = 1e300: a non-finite
+      // residual at the rest shape itself); up to MAX_HART_SMITH_K1 it overflows only at a stretch the
+      // inflation then names (`Inflation.ARubberThatStiffensBeyondDoublePrecisionSaysSoInPhysicalTerms`).
+      if (!(p[1] >= 0 && p[1] <= MAX_HART_SMITH_K1)) {
+        std::ostringstream out;
+        out << "material parameter k1 must be from 0 to " << MAX_HART_SMITH_K1
+            << " (fitted rubbers: 3e-4 to 0.03), got " << p[1];
+        return out.str();
+      }
       if (p[2] < 0) return "material parameter k2 must be non-negative";
       break;
   }

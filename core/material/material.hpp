@@ -45,6 +45,8 @@ Result<MaterialModel> parse_model_name(const std::string& name);
 /// The leading modulus (mu, C1, G) a material may have (MPa): 1 Pa to 100 GPa (C2: 0 to 100 GPa).
 constexpr double MIN_MODULUS_MPA = 1e-6;
 constexpr double MAX_MODULUS_MPA = 1e5;
+/// Hart-Smith's stiffening k1 (dimensionless) may be 0 to this.
+constexpr double MAX_HART_SMITH_K1 = 100.0;
 
 /// Parses `model:name=value,...` (every parameter required, moduli within the bounds above, k1 >= 0, k2 >= 0),
 /// or a preset name (`silicone`, `latex`).

@@ -26,6 +26,10 @@ TEST(Material, ModuliOutsideAnyRubbersAreRefusedWithTheRange) {
   }
   EXPECT_NE(problem_of("neo-hookean:mu=1e-300").find("mu must be a modulus from 1e-06 to 100000 MPa"),
             std::string::npos);
+  // Hart-Smith's k1: up to 100 (k1 = 10 overflows only on the way to x27, which the inflation names);
+  // 1e300 overflowed at the rest shape itself.
+  EXPECT_EQ(problem_of("hart-smith:G=0.1,k1=10,k2=1"), "");
+  EXPECT_NE(problem_of("hart-smith:G=0.1,k1=1e300,k2=1").find("k1 must be from 0 to 100"), std::string::npos);
 }
 
 }  // namespace
