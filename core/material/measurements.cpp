@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <functional>
 #include <sstream>
+#include <utility>
 
 namespace balloon {
 namespace {
@@ -52,6 +53,14 @@ std::string number_text(double v) {
 
 bool is_stress_table(TestKind kind) { return kind != TestKind::Bulge; }
 
+/// Bounds on measured values (see validate): the largest stress (MPa) or pressure (kPa) a table may have.
+constexpr double MIN_LARGEST_STRESS_MPA = 1e-7;
+constexpr double MAX_STRESS_MPA = 1e5;
+constexpr double MIN_LARGEST_PRESSURE_KPA = 1e-6;
+constexpr double MAX_PRESSURE_KPA = 1e6;
+/// A bulge disc no larger than any mesh may be (mm).
+constexpr double MAX_DISC_RADIUS_MM = 1e6;
+
 std::string expected_header(TestKind kind) {
   return is_stress_table(kind) ? "stretch,nominal_stress_MPa" : "pressure_kpa,extension_ratio[,apex_height_mm]";
 }
@@ -84,6 +93,19 @@ std::string validate(const MeasurementSet& set, const std::function<std::string(
   }
   if (n < 2)
     return n == 0 ? "no data rows" : "only 1 data point (at least 2 are needed to fit a curve)";
+  // The data's scale against what a rubber can give: a modulus of 1 Pa to 100 GPa (material.hpp). Far
+  // outside it no fit exists, and the optimizer only said "no starting point reproduces the data's sign".
+  const double largest = *std::max_element(set.y.begin(), set.y.end());
+  const auto [smallest_y, largest_y] = is_stress_table(set.kind) ? std::pair{MIN_LARGEST_STRESS_MPA, MAX_STRESS_MPA}
+                                                                 : std::pair{MIN_LARGEST_PRESSURE_KPA, MAX_PRESSURE_KPA};
+  // (All zeros is a problem of its own, which the fit names.)
+  if (largest > 0.0 && !(largest >= smallest_y && largest <= largest_y)) {
+    std::ostringstream out;
+    out << "the largest " << y_name << ", " << number_text(largest) << (is_stress_table(set.kind) ? " MPa" : " kPa")
+        << ", is outside what a rubber gives (" << smallest_y << " to " << largest_y
+        << (is_stress_table(set.kind) ? " MPa): are the units MPa?" : " kPa): are the units kPa?");
+    return out.str();
+  }
   if (is_stress_table(set.kind)) {
     const auto [lo, hi] = std::minmax_element(set.y.begin(), set.y.end());
     const double range = *hi - *lo;
@@ -208,6 +230,8 @@ std::string measurement_problem(const MeasurementSet& set) {
   if (auto problem = validate(set, where); !problem.empty()) return problem;
   if (set.kind == TestKind::Bulge) {
     if (!(set.disc_radius_mm > 0.0 && std::isfinite(set.disc_radius_mm))) return "bulge data needs a disc radius > 0 mm";
+    if (set.disc_radius_mm > MAX_DISC_RADIUS_MM)
+      return "bulge data: a disc radius of " + number_text(set.disc_radius_mm) + " mm is larger than any rig (at most 1e+06 mm)";
     if (!(set.thickness_mm > 0.0 && std::isfinite(set.thickness_mm))) return "bulge data needs a disc thickness > 0 mm";
   }
   return "";

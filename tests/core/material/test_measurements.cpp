@@ -86,6 +86,12 @@ TEST(Measurements, BadInputGivesClearErrors) {
   expect_error("# c\n# c\n" + header + "1.1,0.1\nabc,0.2\n", TestKind::Uniaxial, "line 5, column 1: 'abc' is not a number");
   expect_error("# c\n# c\n" + header + "1.1,0.1\n1.2,abc\n", TestKind::Uniaxial, "line 5, column 2: 'abc' is not a number");
   expect_error(header + "1.1,0.1x\n1.2,0.2\n", TestKind::Uniaxial, "line 2, column 2: '0.1x' is not a number");
+  // Values no rubber gives (a unit slip, or hostile): named with the range, not left to the fit, whose
+  // optimizer found "no starting point" for them.
+  expect_error(header + "1.1,1e300\n1.2,1e300\n", TestKind::Uniaxial,
+               "the largest nominal stress, 1e+300 MPa, is outside what a rubber gives (1e-07 to 100000 MPa)");
+  expect_error(header + "1.1,1e-300\n1.2,2e-300\n", TestKind::Uniaxial, "are the units MPa?");
+  expect_error("pressure_kpa,extension_ratio\n1e9,1.1\n2e9,1.2\n", TestKind::Bulge, "are the units kPa?");
   {
     // A huge cell is quoted by its first 40 characters: the message stays one short line.
     const auto parsed = parse_measurements(header + "1.1," + std::string(100000, '7') + "x\n1.2,0.2\n", TestKind::Uniaxial);
@@ -129,6 +135,9 @@ TEST(Measurements, ProblemCheckCoversSetsBuiltInCode) {
   EXPECT_EQ(measurement_problem(set), "bulge data needs a disc thickness > 0 mm");
   set.thickness_mm = 0.5;
   EXPECT_EQ(measurement_problem(set), "");
+  set.disc_radius_mm = 1e300;  // the fit only said "no starting point reproduces the data's sign"
+  EXPECT_NE(measurement_problem(set).find("larger than any rig"), std::string::npos);
+  set.disc_radius_mm = 30;
   set.y = {1.0};
   EXPECT_NE(measurement_problem(set).find("2 x values but 1 y values"), std::string::npos);
 }
