@@ -7,7 +7,7 @@
 #include "design/design_driver.hpp"
 #include "design/multiresolution_design.hpp"
 #include "design/reduced_space_design.hpp"
-#include "fem/thin_sheet.hpp"
+#include "material/thin_sheet.hpp"
 #include "mesh/mesh_geometry.hpp"
 
 namespace balloon {

@@ -1,11 +1,14 @@
 #include "material/measurements.hpp"
 
+#include "material/thin_sheet.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <functional>
 #include <sstream>
+#include <string_view>
 #include <utility>
 
 namespace balloon {
@@ -60,6 +63,23 @@ constexpr double MIN_LARGEST_PRESSURE_KPA = 1e-6;
 constexpr double MAX_PRESSURE_KPA = 1e6;
 /// A bulge disc no larger than any mesh may be (mm).
 constexpr double MAX_DISC_RADIUS_MM = 1e6;
+/// The largest stretch (or bulge extension ratio) a table may hold: rubbers break below about 10.
+constexpr double MAX_MEASURED_STRETCH = 20.0;
+
+/// Why a stretch far beyond any rubber's break is in the data, with the likely mix-up; "" below the bound.
+std::string stretch_beyond_rubber(const std::string& x_name, double x) {
+  if (!(x > MAX_MEASURED_STRETCH)) return "";
+  return x_name + " " + number_text(x) + " is beyond any rubber (rubbers break below a stretch of about 10; at most " +
+         number_text(MAX_MEASURED_STRETCH) + " is accepted): is the column the elongation in percent? The " +
+         x_name + " is a length ratio (100% elongation is a stretch of 2)";
+}
+
+/// The hint for tables whose rows all had stretch < 1: often the strain, not the stretch.
+std::string dropped_compression_text(int dropped) {
+  return std::to_string(dropped) + (dropped == 1 ? " row" : " rows") +
+         " with stretch below 1 dropped: compression is not fitted; if the column holds the strain dL/L0, give the "
+         "stretch 1 + strain";
+}
 
 std::string expected_header(TestKind kind) {
   return is_stress_table(kind) ? "stretch,nominal_stress_MPa" : "pressure_kpa,extension_ratio[,apex_height_mm]";
@@ -75,6 +95,7 @@ std::string validate(const MeasurementSet& set, const std::function<std::string(
   const std::string y_name = is_stress_table(set.kind) ? "nominal stress" : "pressure";
   for (size_t i = 0; i < n; ++i) {
     if (!std::isfinite(set.x[i]) || !std::isfinite(set.y[i])) return where(i) + ": values must be finite numbers";
+    if (auto beyond = stretch_beyond_rubber(x_name, set.x[i]); !beyond.empty()) return where(i) + ": " + beyond;
     if (is_stress_table(set.kind)) {
       if (set.x[i] < 1.0) return where(i) + ": stretch " + number_text(set.x[i]) + " < 1 (compression is not fitted)";
       if (set.y[i] < 0.0)
@@ -91,8 +112,11 @@ std::string validate(const MeasurementSet& set, const std::function<std::string(
       return where(i) + ": " + x_name + " " + number_text(set.x[i]) + " is not larger than the previous row's " +
              number_text(set.x[i - 1]) + " (rows must be in loading order, " + x_name + " strictly increasing)";
   }
-  if (n < 2)
-    return n == 0 ? "no data rows" : "only 1 data point (at least 2 are needed to fit a curve)";
+  if (n < 2) {
+    const std::string dropped =
+        set.dropped_compression_points > 0 ? "; " + dropped_compression_text(set.dropped_compression_points) : "";
+    return (n == 0 ? "no data rows" : "only 1 data point (at least 2 are needed to fit a curve)") + dropped;
+  }
   // The data's scale against what a rubber can give: a modulus of 1 Pa to 100 GPa (material.hpp). Far
   // outside it no fit exists, and the optimizer only said "no starting point reproduces the data's sign".
   const double largest = *std::max_element(set.y.begin(), set.y.end());
@@ -154,7 +178,10 @@ Result<MeasurementSet> parse_measurements(const std::string& csv_text, TestKind 
                                                 : std::vector<std::string>{"extension_ratio", "pressure_kpa", "apex_height_mm"};
   std::vector<int> role_of_column;
   std::vector<int> line_of_row;
-  std::stringstream stream(csv_text);
+  std::istringstream stream(csv_text);
+  // A UTF-8 byte order mark (spreadsheets write one with "CSV UTF-8") is not part of the first column's name.
+  constexpr std::string_view BYTE_ORDER_MARK = "\xEF\xBB\xBF";
+  if (csv_text.rfind(BYTE_ORDER_MARK, 0) == 0) stream.ignore(static_cast<std::streamsize>(BYTE_ORDER_MARK.size()));
   std::string raw;
   int line_number = 0;
   bool have_header = false;
@@ -217,7 +244,7 @@ Result<MeasurementSet> parse_measurements(const std::string& csv_text, TestKind 
   if (!have_header) return fail("no header row: the text has only comments (expected header '" + expected_header(kind) + "')");
   if (set.x.empty()) {
     if (set.dropped_compression_points > 0)
-      return fail("no data rows with stretch >= 1 (" + std::to_string(set.dropped_compression_points) + " compression rows dropped)");
+      return fail("no data rows with stretch >= 1 (" + dropped_compression_text(set.dropped_compression_points) + ")");
     return fail("no data rows after the header");
   }
   const auto where = [&](size_t i) { return "line " + std::to_string(line_of_row[i]); };
@@ -233,6 +260,14 @@ std::string measurement_problem(const MeasurementSet& set) {
     if (set.disc_radius_mm > MAX_DISC_RADIUS_MM)
       return "bulge data: a disc radius of " + number_text(set.disc_radius_mm) + " mm is larger than any rig (at most 1e+06 mm)";
     if (!(set.thickness_mm > 0.0 && std::isfinite(set.thickness_mm))) return "bulge data needs a disc thickness > 0 mm";
+    if (auto problem = thickness_problem(set.thickness_mm); !problem.empty()) return "bulge data: disc " + problem;
+    // The disc's rest shape is as wide as the opening: the balloon's thin-sheet rule, on its diameter.
+    const double diameter_mm = 2.0 * set.disc_radius_mm;
+    if (set.thickness_mm > MAX_THICKNESS_PER_DIAGONAL * diameter_mm * (1.0 + THIN_SHEET_SLACK))
+      return "bulge data: a disc " + number_text(set.thickness_mm) + " mm thick over an opening of radius " +
+             number_text(set.disc_radius_mm) + " mm is no thin sheet: the membrane model needs the thickness at most " +
+             number_text(100.0 * MAX_THICKNESS_PER_DIAGONAL) + "% of the opening's diameter (" +
+             number_text(MAX_THICKNESS_PER_DIAGONAL * diameter_mm) + " mm here)";
   }
   return "";
 }

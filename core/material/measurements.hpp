@@ -32,7 +32,8 @@ struct MeasurementSet {
 
 /// Parses CSV text into a measurement set of the given kind.
 ///
-/// Format: blank lines and lines starting with `#` are skipped; the first other line is the header.
+/// Format: a leading UTF-8 byte order mark is ignored; blank lines and lines starting with `#` are skipped;
+/// the first other line is the header.
 ///  - stress tables (uniaxial, equibiaxial, pure-shear): columns `stretch,nominal_stress_MPa`
 ///  - bulge: columns `pressure_kpa,extension_ratio` and optionally `apex_height_mm`
 /// Column names are matched case-insensitively and may come in any order; unknown columns are errors.
@@ -46,12 +47,15 @@ struct MeasurementSet {
 ///    row by row (rows in inflation order; the pressure may fall past a pressure maximum, as in a
 ///    volume-controlled test), and the pressure at the last row exceeds the pressure at the first (the disc
 ///    inflates as the pressure rises overall);
+///  - no stretch or extension ratio above 20 (rubbers break below about 10: such a column is likely the
+///    elongation in percent);
 ///  - at least 2 rows remain (a single point cannot fit a curve).
 /// disc_radius_mm and thickness_mm are not in the CSV: the caller sets them for bulge data.
 Result<MeasurementSet> parse_measurements(const std::string& csv_text, TestKind kind, const std::string& label = "");
 
-/// Checks a set built in code (same rules as the parser, plus disc radius and thickness > 0 for bulge
-/// sets); returns an empty string when it is usable for fitting.
+/// Checks a set built in code (same rules as the parser, plus, for bulge sets, a disc radius > 0 and a
+/// thickness of at least MIN_THICKNESS_MM and at most the thin-sheet limit of the opening's diameter,
+/// material/thin_sheet.hpp); returns an empty string when it is usable for fitting.
 std::string measurement_problem(const MeasurementSet& set);
 
 }  // namespace balloon

@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "fem/balloon_model.hpp"
-#include "fem/thin_sheet.hpp"
+#include "material/thin_sheet.hpp"
 #include "mesh/cap_sliver_flips.hpp"
 #include "mesh/mesh_geometry.hpp"
 #include "mesh/self_intersection.hpp"

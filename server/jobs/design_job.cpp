@@ -5,7 +5,7 @@
 #include <cstdio>
 
 #include "design/mold.hpp"
-#include "fem/thin_sheet.hpp"
+#include "material/thin_sheet.hpp"
 #include "jobs/json_writer.hpp"
 #include "jobs/mesh_size.hpp"
 #include "mesh/mesh_geometry.hpp"

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <sstream>
 
-#include "fem/thin_sheet.hpp"
+#include "material/thin_sheet.hpp"
 #include "jobs/mesh_size.hpp"
 #include "mesh/mesh_checks.hpp"
 #include "mesh/mesh_geometry.hpp"

@@ -105,8 +105,17 @@ TEST(Measurements, BadInputGivesClearErrors) {
   expect_error(header + "1.1,\n1.2,0.2\n", TestKind::Uniaxial, "line 2, column 2: empty cell");
   expect_error(header + "1.1,0.1,7\n", TestKind::Uniaxial, "line 2: expected 2 cells, found 3");
   expect_error(header + "1.1,0.1\n", TestKind::Uniaxial, "only 1 data point");
-  expect_error(header + "0.8,-0.1\n1.1,0.1\n", TestKind::Uniaxial, "only 1 data point");
-  expect_error(header + "0.8,-0.1\n0.9,-0.05\n", TestKind::Uniaxial, "no data rows with stretch >= 1 (2 compression rows dropped)");
+  // Rows of stretch below 1 are dropped, and the message says so (with the strain-for-stretch mix-up).
+  expect_error(header + "0.8,-0.1\n1.1,0.1\n", TestKind::Uniaxial,
+               "only 1 data point (at least 2 are needed to fit a curve); 1 row with stretch below 1 dropped");
+  expect_error(header + "0.8,-0.1\n0.9,-0.05\n", TestKind::Uniaxial,
+               "no data rows with stretch >= 1 (2 rows with stretch below 1 dropped: compression is not fitted; if the "
+               "column holds the strain dL/L0, give the stretch 1 + strain)");
+  // A stretch no rubber reaches is likely an elongation in percent (the fit said "no starting point of
+  // hart-smith reproduces the data's sign (are the values positive?)" at 200).
+  expect_error(header + "1.2,0.2\n1.4,0.3\n200,1\n", TestKind::Uniaxial,
+               "line 4: stretch 200 is beyond any rubber (rubbers break below a stretch of about 10; at most 20 is "
+               "accepted): is the column the elongation in percent?");
   expect_error(header + "-1,0.1\n1.1,0.1\n", TestKind::Uniaxial, "line 2, column 1: stretch -1 must be positive");
   expect_error(header + "1.1,0.1\n1.3,0.3\n1.2,0.35\n", TestKind::Uniaxial, "line 4: stretch 1.2 is not larger than the previous row's 1.3");
   expect_error(header + "1.1,0.1\n1.1,0.2\n", TestKind::Uniaxial, "line 3: stretch 1.1 is not larger");
@@ -119,10 +128,39 @@ TEST(Measurements, BadInputGivesClearErrors) {
   expect_error(bulge + "1,1.3\n3,1.2\n", TestKind::Bulge, "line 3: extension ratio 1.2 is not larger than the previous row's 1.3");
   expect_error(bulge + "5,1.1\n3,1.2\n2,1.5\n", TestKind::Bulge, "must grow with pressure overall");
   expect_error(bulge + "1,1.1\n", TestKind::Bulge, "only 1 data point");
+  expect_error(bulge + "1,1.1\n3,25\n", TestKind::Bulge, "line 3: extension ratio 25 is beyond any rubber");
   expect_error("pressure_kpa\n1\n2\n", TestKind::Bulge, "header has no column 'extension_ratio'");
   expect_error("stretch,nominal_stress_MPa\n1.1,0.1\n", TestKind::Bulge, "looks like a stress-stretch table");
   expect_error(bulge.substr(0, bulge.size() - 1) + ",apex_height_mm\n1,1.1,-3\n2,1.2,4\n", TestKind::Bulge,
                "line 2: apex height must be a finite number >= 0 mm");
+}
+
+TEST(Measurements, ASpreadsheetsByteOrderMarkIsNotPartOfTheHeader) {
+  // Spreadsheets' "CSV UTF-8" starts with one; it was read as part of the name: "unknown column '?stretch'".
+  const auto parsed = parse_measurements("\xEF\xBB\xBFstretch,nominal_stress_MPa\n1.2,0.2\n1.4,0.3\n", TestKind::Uniaxial);
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  EXPECT_EQ(parsed->x, (std::vector<double>{1.2, 1.4}));
+  EXPECT_EQ(parsed->y, (std::vector<double>{0.2, 0.3}));
+}
+
+TEST(Measurements, ABulgeDiscMustBeAThinSheetOfAtLeastAMicrometre) {
+  MeasurementSet set;
+  set.kind = TestKind::Bulge;
+  set.x = {1.1, 1.3};
+  set.y = {1.0, 2.0};
+  set.disc_radius_mm = 15;
+  set.thickness_mm = 3.0;  // 10% of the 30 mm opening: the limit passes
+  EXPECT_EQ(measurement_problem(set), "");
+  // Both were fitted before: 20 mm as if it were a membrane, 1e-300 mm into "no starting point reproduces
+  // the data's sign".
+  set.thickness_mm = 20.0;
+  EXPECT_EQ(measurement_problem(set),
+            "bulge data: a disc 20 mm thick over an opening of radius 15 mm is no thin sheet: the membrane model needs "
+            "the thickness at most 10% of the opening's diameter (3 mm here)");
+  set.thickness_mm = 1e-300;
+  EXPECT_NE(measurement_problem(set).find("bulge data: disc thickness must be a positive number of mm, at least 0.001"),
+            std::string::npos)
+      << measurement_problem(set);
 }
 
 TEST(Measurements, ProblemCheckCoversSetsBuiltInCode) {

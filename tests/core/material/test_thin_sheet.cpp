@@ -1,8 +1,8 @@
 #include <gtest/gtest.h>
 
 #include "design/balloon_design.hpp"
-#include "fem/thin_sheet.hpp"
 #include "material/material.hpp"
+#include "material/thin_sheet.hpp"
 #include "mesh/icosphere.hpp"
 #include "mesh/mesh_geometry.hpp"
 #include "solve/inflation.hpp"

@@ -1,4 +1,4 @@
-#include "fem/thin_sheet.hpp"
+#include "material/thin_sheet.hpp"
 
 #include <cmath>
 #include <sstream>
