@@ -107,8 +107,9 @@ std::vector<FieldProblem> design_parameter_problems(const DesignParameters& para
   return problems;
 }
 
-std::string design_sheet_problem(const DesignParameters& parameters, double target_diagonal_mm) {
+std::string design_size_problem(const DesignParameters& parameters, double target_diagonal_mm) {
   const double diagonal_mm = parameters.size_mm > 0.0 ? parameters.size_mm : target_diagonal_mm;
+  if (std::string problem = mesh_size_problem(diagonal_mm); !problem.empty()) return problem;
   return thin_sheet_problem(parameters.thickness_mm, start_scale(parameters) * diagonal_mm);
 }
 
@@ -129,7 +130,7 @@ Result<DesignInput> prepare_design(TriMesh target, const Material& material, con
   input.parameters = parameters;
   input.method = parameters.method.empty() ? DesignOptions{}.method : *parse_design_method(parameters.method);
   input.start_scale = start_scale(parameters);
-  if (const std::string problem = design_sheet_problem(parameters, bounding_box_diagonal(input.target.mesh.vertices));
+  if (const std::string problem = design_size_problem(parameters, bounding_box_diagonal(input.target.mesh.vertices));
       !problem.empty())
     return fail("mesh: " + problem);
   if (!parameters.nozzle.empty()) {

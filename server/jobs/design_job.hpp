@@ -62,10 +62,11 @@ struct DesignInput {
   std::optional<NozzleSelection> nozzle;  ///< selected on the prepared target when a nozzle was asked
 };
 
-/// Why the sheet is too thick for the thin-sheet model (fem/thin_sheet.hpp) on this design's start, the
-/// target `target_diagonal_mm` across (after `size_mm`) scaled down by `scale` or to 1 / `volume_ratio` of
-/// its volume; "" when it is thin. Cheap: the service asks before remeshing, prepare_design again.
-std::string design_sheet_problem(const DesignParameters& parameters, double target_diagonal_mm);
+/// Why the target `target_diagonal_mm` across (after `size_mm`) is too large (mesh_size_problem), or the
+/// sheet too thick for the thin-sheet model (material/thin_sheet.hpp) on this design's start, the target
+/// scaled down by `scale` or to 1 / `volume_ratio` of its volume; "" when neither. Cheap: the service asks
+/// before remeshing, prepare_design again.
+std::string design_size_problem(const DesignParameters& parameters, double target_diagonal_mm);
 
 /// Checks the parameters and the material, prepares the target (prepare_target: size, resolution;
 /// fails on bad meshes with a message starting "mesh: ") and selects the nozzle vertices.

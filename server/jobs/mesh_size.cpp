@@ -13,4 +13,14 @@ std::string size_mm_problem(double size_mm) {
   return buffer;
 }
 
+std::string mesh_size_problem(double diagonal_mm) {
+  if (diagonal_mm <= MAX_SIZE_MM) return "";
+  char buffer[240];
+  std::snprintf(buffer, sizeof(buffer),
+                "the mesh is %.3g mm across (bounding-box diagonal), more than %g mm (a kilometre): mesh coordinates "
+                "are read as mm; scale it (--size MM)",
+                diagonal_mm, MAX_SIZE_MM);
+  return buffer;
+}
+
 }  // namespace balloon::jobs

@@ -59,6 +59,8 @@ Result<SimulateInput> prepare_simulate(TriMesh rest, const Material& material,
     return fail("mesh: it has no extent to scale to size_mm");
   Result<MeshCheckReport> report = validate_balloon_mesh(rest);
   if (!report) return fail("mesh: " + report.error());
+  if (const std::string problem = mesh_size_problem(bounding_box_diagonal(rest.vertices)); !problem.empty())
+    return fail("mesh: " + problem);
   if (const std::string problem = thin_sheet_problem(parameters.thickness_mm, bounding_box_diagonal(rest.vertices));
       !problem.empty())
     return fail("mesh: " + problem);

@@ -85,7 +85,7 @@ ServiceStatus decode_design(const v1::DesignJob& job, const std::string& tenant,
     TriMesh checked = mesh;
     if (Result<MeshCheckReport> report = validate_balloon_mesh(checked); !report)
       return ServiceStatus::bad_field("target_mesh", "target_mesh: target mesh: " + report.error());
-    if (const std::string problem = jobs::design_sheet_problem(parameters, bounding_box_diagonal(checked.vertices));
+    if (const std::string problem = jobs::design_size_problem(parameters, bounding_box_diagonal(checked.vertices));
         !problem.empty())
       return ServiceStatus::bad_field("target_mesh", "target_mesh: " + problem);
     if (const std::string problem = nozzle_problem(std::move(checked), parameters); !problem.empty())

@@ -469,6 +469,15 @@ TEST(HostileInputs, CatalogueGetsItsStatusesAndTheServerStaysServingAndSmall) {
     design.mutable_spec()->mutable_design()->set_thickness_mm(thin);
     submit_case("design thickness_mm " + std::to_string(thin), design, StatusCode::INVALID_ARGUMENT, "at least 0.001");
   }
+  // A mesh a kilometre or more across read as mm (a file in micrometres): simulate "converged" at 1e30 mm
+  // and 3.8e-28 kPa. Refused at submit like size_mm above 1e6, naming the size and the remedy.
+  const std::string huge_sphere = write_mesh_to_memory(make_icosphere(1e29, 1), "obj");
+  const std::string too_large = "mm across (bounding-box diagonal), more than 1e+06 mm (a kilometre)";
+  submit_case("simulate a 1e30 mm mesh", simulate_with_mesh(huge_sphere, v1::MESH_FORMAT_OBJ), StatusCode::INVALID_ARGUMENT,
+              too_large);
+  v1::SubmitJobRequest huge_design = good_design();
+  huge_design.mutable_spec()->mutable_design()->mutable_target_mesh()->set_data(huge_sphere);
+  submit_case("design a 1e30 mm target", huge_design, StatusCode::INVALID_ARGUMENT, too_large);
   v1::SubmitJobRequest unit_scale = good_design();
   unit_scale.mutable_spec()->mutable_design()->set_scale(1.0);
   submit_case("design scale 1", unit_scale, StatusCode::INVALID_ARGUMENT, "below 1");
