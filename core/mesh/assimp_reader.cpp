@@ -1,6 +1,7 @@
 #include "mesh/assimp_reader.hpp"
 
 #include "mesh/gltf_layout_check.hpp"
+#include "mesh/polygon_triangulation.hpp"
 
 #include <Eigen/Geometry>
 
@@ -646,9 +647,10 @@ class SceneMerger {
         continue;
       }
       if (face.mNumIndices > 3) {
-        m_error = "face " + std::to_string(m_face_index) + " has " + std::to_string(face.mNumIndices) +
-                  " vertices; only triangles are supported";
-        return;
+        append_polygon(mesh, face, welded, mirrored);
+        if (!m_error.empty()) return;
+        ++m_face_index;
+        continue;
       }
       for (const int k : mirrored ? std::array{0, 2, 1} : std::array{0, 1, 2}) {
         const unsigned index = face.mIndices[k];
@@ -661,6 +663,28 @@ class SceneMerger {
       ++m_face_index;
     }
     ++m_meshes_appended;
+  }
+
+  /// A polygon face (a PLY's quads) split into triangles, in the mirrored winding when `mirrored`.
+  void append_polygon(const aiMesh& mesh, const aiFace& face, const std::vector<int>& welded, bool mirrored) {
+    if (face.mNumIndices > static_cast<unsigned>(MAX_POLYGON_CORNERS)) {
+      m_error = "face " + std::to_string(m_face_index) + " has " + std::to_string(face.mNumIndices) +
+                " vertices; polygons of up to " + std::to_string(MAX_POLYGON_CORNERS) + " are split into triangles";
+      return;
+    }
+    std::vector<int> corners;
+    corners.reserve(face.mNumIndices);
+    for (unsigned k = 0; k < face.mNumIndices; ++k) {
+      if (face.mIndices[k] >= mesh.mNumVertices) {
+        m_error = "face " + std::to_string(m_face_index) + " refers to a missing vertex";
+        return;
+      }
+      corners.push_back(welded[face.mIndices[k]]);
+    }
+    if (mirrored) std::reverse(corners.begin(), corners.end());
+    const std::int64_t triangles = static_cast<std::int64_t>(m_indices.size() / 3 + corners.size() - 2);
+    m_error = over_limit_message(triangles, m_limits.max_faces, "faces");
+    if (m_error.empty()) append_polygon_triangles(corners, m_coordinates, m_indices);
   }
 
   const aiScene& m_scene;

@@ -1,6 +1,7 @@
 #include "mesh/mesh_io.hpp"
 
 #include "mesh/assimp_reader.hpp"
+#include "mesh/polygon_triangulation.hpp"
 
 #include <Eigen/Geometry>
 
@@ -115,6 +116,23 @@ TriMesh to_mesh(const std::vector<double>& coordinates, const std::vector<int>& 
   return mesh;
 }
 
+/// Why a face of `corners` corners cannot be read (fewer than 3, more than MAX_POLYGON_CORNERS), or "".
+std::string polygon_corner_problem(long corners) {
+  if (corners >= 3 && corners <= MAX_POLYGON_CORNERS) return "";
+  if (corners < 3) return "has " + std::to_string(corners) + " vertices; a face needs at least 3";
+  return "has " + std::to_string(corners) + " vertices; polygons of up to " + std::to_string(MAX_POLYGON_CORNERS) +
+         " are split into triangles";
+}
+
+/// Appends `face` to `indices` as triangles (append_polygon_triangles); false when they would pass
+/// `max_faces` (0: no limit).
+bool append_face(const std::vector<int>& face, const std::vector<double>& coordinates, std::vector<int>& indices,
+                 std::int64_t max_faces) {
+  if (max_faces > 0 && static_cast<std::int64_t>(indices.size() / 3 + face.size() - 2) > max_faces) return false;
+  append_polygon_triangles(face, coordinates, indices);
+  return true;
+}
+
 // ---------------------------------------------------------------------------------------------
 // OBJ and OFF are parsed here rather than by assimp: assimp gives every face corner its own vertex
 // (so the file's vertex order is lost, and OBJ texture seams stay split), and stores single
@@ -127,6 +145,7 @@ Result<TriMesh> parse_obj(std::string_view text, const MeshReadLimits& limits) {
   std::string_view line;
   int face_index = 0;
   std::vector<std::string_view> tokens;
+  std::vector<int> face;
   auto where = [&]() { return "line " + std::to_string(lines.line_number()); };
   while (lines.next(line)) {
     split_tokens(line, tokens);
@@ -150,12 +169,11 @@ Result<TriMesh> parse_obj(std::string_view text, const MeshReadLimits& limits) {
         return fail(over);
       }
       const std::size_t corners = tokens.size() - 1;
-      if (corners != 3) {
-        return fail("face " + std::to_string(face_index) + " (" + where() + ") has " +
-                    std::to_string(corners) + " vertices; only triangles are supported");
-      }
+      if (const std::string problem = polygon_corner_problem(static_cast<long>(corners)); !problem.empty())
+        return fail("face " + std::to_string(face_index) + " (" + where() + ") " + problem);
       const long vertex_count = static_cast<long>(coordinates.size() / 3);
-      for (std::size_t k = 1; k <= 3; ++k) {
+      face.clear();
+      for (std::size_t k = 1; k <= corners; ++k) {
         // "v", "v/vt", "v//vn" or "v/vt/vn": only the position index matters.
         const std::string_view ref = tokens[k].substr(0, tokens[k].find('/'));
         long index = 0;
@@ -170,8 +188,10 @@ Result<TriMesh> parse_obj(std::string_view text, const MeshReadLimits& limits) {
                       std::to_string(index) + " but only " + std::to_string(vertex_count) +
                       " vertices precede it");
         }
-        indices.push_back(static_cast<int>(zero_based));
+        face.push_back(static_cast<int>(zero_based));
       }
+      if (!append_face(face, coordinates, indices, limits.max_faces))
+        return fail(over_limit_message(static_cast<std::int64_t>(indices.size() / 3 + corners - 2), limits.max_faces, "faces"));
       ++face_index;
     }
     // Everything else (vt, vn, o, g, s, usemtl, mtllib, l, p) describes no surface: ignored.
@@ -245,6 +265,7 @@ Result<TriMesh> parse_off(std::string_view text, const MeshReadLimits& limits) {
   }
   std::vector<int> indices;
   indices.reserve(static_cast<std::size_t>(3 * face_count));
+  std::vector<int> face;
   for (long f = 0; f < face_count; ++f) {
     if (!next_tokens()) {
       return fail("file ends after " + std::to_string(f) + " of " + std::to_string(face_count) + " faces");
@@ -253,12 +274,12 @@ Result<TriMesh> parse_off(std::string_view text, const MeshReadLimits& limits) {
     if (!parse_long(tokens[0], corners)) {
       return fail(where() + ": bad vertex count " + quoted(tokens[0]) + " of face " + std::to_string(f));
     }
-    if (corners != 3) {
-      return fail("face " + std::to_string(f) + " (" + where() + ") has " + std::to_string(corners) +
-                  " vertices; only triangles are supported");
-    }
-    if (tokens.size() < 4) return fail(where() + ": face " + std::to_string(f) + " lists fewer than 3 vertices");
-    for (std::size_t k = 1; k <= 3; ++k) {  // anything after the indices is a colour: ignored
+    if (const std::string problem = polygon_corner_problem(corners); !problem.empty())
+      return fail("face " + std::to_string(f) + " (" + where() + ") " + problem);
+    if (tokens.size() < static_cast<std::size_t>(corners) + 1)
+      return fail(where() + ": face " + std::to_string(f) + " lists fewer than its " + std::to_string(corners) + " vertices");
+    face.clear();
+    for (std::size_t k = 1; k <= static_cast<std::size_t>(corners); ++k) {  // anything after the indices is a colour: ignored
       long index = 0;
       if (!parse_long(tokens[k], index)) {
         return fail(where() + ": bad vertex index " + quoted(tokens[k]) + " in face " + std::to_string(f));
@@ -267,8 +288,10 @@ Result<TriMesh> parse_off(std::string_view text, const MeshReadLimits& limits) {
         return fail("face " + std::to_string(f) + " (" + where() + ") refers to vertex " +
                     std::to_string(index) + ", out of range 0.." + std::to_string(vertex_count - 1));
       }
-      indices.push_back(static_cast<int>(index));
+      face.push_back(static_cast<int>(index));
     }
+    if (!append_face(face, coordinates, indices, limits.max_faces))
+      return fail(over_limit_message(static_cast<std::int64_t>(indices.size() / 3) + corners - 2, limits.max_faces, "faces"));
   }
   if (indices.empty()) return fail("no triangles (the header declares 0 faces)");
   return to_mesh(coordinates, indices);
