@@ -134,8 +134,18 @@ Result<FitOutcome> run_fit(const FitInput& input, const CancelToken* cancel) {
   for (MaterialModel model : input.models) {
     if (cancel != nullptr && cancel->cancelled()) return fail(FIT_CANCELLED);
     Result<FitResult> fit = fit_material(model, input.sets, options);
-    if (!fit) return fail(model_name(model) + ": " + fit.error());
+    const bool cancelled = cancel != nullptr && cancel->cancelled();
+    if (!fit && (cancelled || !input.all_models)) return fail(model_name(model) + ": " + fit.error());
+    if (!fit) {
+      outcome.skipped.push_back({model, fit.error()});
+      continue;
+    }
     outcome.fits.push_back(std::move(*fit));
+  }
+  if (outcome.fits.empty()) {
+    std::string reasons;
+    for (const FitSkip& skip : outcome.skipped) reasons += (reasons.empty() ? "" : "; ") + model_name(skip.model) + ": " + skip.reason;
+    return fail("no law fits this data (" + reasons + ")");
   }
   outcome.time_s = now_s() - start;
   return outcome;
@@ -213,6 +223,12 @@ std::string fit_report_json(const FitInput& input, const FitOutcome& outcome) {
     if (i == 0) json.value("plot_svg", plot);
     json.end_object();
   }
+  for (const FitSkip& skip : outcome.skipped) {  // "all" only, so in the list
+    json.begin_object();
+    json.value("model", model_name(skip.model));
+    json.value("skipped", skip.reason);
+    json.end_object();
+  }
   if (list) json.end_array();
   return json.str();
 }
@@ -241,6 +257,8 @@ std::string fit_summary_text(const FitInput& input, const FitOutcome& outcome) {
         << regimes_text(fit.model_inflection, fit.model_stiffening) << "\n";
     if (!fit.converged) out << "  note: " << fit.message << "\n";
   }
+  for (const FitSkip& skip : outcome.skipped)
+    out << "\n" << model_name(skip.model) << ": not fitted: " << skip.reason << "\n";
   if (outcome.fits.size() > 1) {
     const FitResult& best = outcome.fits[static_cast<size_t>(best_fit_index(outcome))];
     out << "\nbest: " << model_name(best.material.model) << "\n";

@@ -35,15 +35,24 @@ struct FitInput {
 /// (see parse_measurements; bulge files also need radius and thickness). The error names the file.
 Result<FitInput> prepare_fit(const std::vector<FitDataFile>& files, const std::string& model);
 
-/// The fits, one per model of the input, in the input's order.
+/// A model that "all" left out because the data cannot fit it, and why.
+struct FitSkip {
+  MaterialModel model = MaterialModel::NeoHookean;
+  std::string reason;
+};
+
+/// The fits, one per model of the input in the input's order, less the ones skipped.
 struct FitOutcome {
   std::vector<FitResult> fits;
+  std::vector<FitSkip> skipped;  ///< "all" only: models the data cannot fit (at least one model is fitted)
   double time_s = 0.0;  ///< wall time of all fits (s)
 };
 
 /// Fits every model. Bulge sets are simulated by the axisymmetric membrane (core/calibration/
 /// axisymmetric_bulge) at their apex heights when the data has them, else at their extension ratios.
-/// Fails with a message when the data cannot be fitted (e.g. fewer points than parameters), or with
+/// Fails with a message when the data cannot be fitted (e.g. fewer points than parameters); with "all",
+/// only when no model can be, the others being listed in `skipped` (2 points fit Neo-Hookean and
+/// Mooney-Rivlin but not Hart-Smith's 3 constants, which failed the whole command before). Fails with
 /// FIT_CANCELLED once `cancel` (may be null) fires: it is checked between iterations of every fit.
 Result<FitOutcome> run_fit(const FitInput& input, const CancelToken* cancel = nullptr);
 

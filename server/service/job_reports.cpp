@@ -1,5 +1,6 @@
 #include "service/job_reports.hpp"
 
+#include <algorithm>
 #include <limits>
 
 namespace balloon::service {
@@ -227,17 +228,35 @@ v1::FitReport fit_report(const jobs::FitInput& input, const jobs::FitOutcome& ou
   }
   if (!outcome.fits.empty()) report.set_best_fit(jobs::best_fit_index(outcome));
   report.set_plot_svg(jobs::fit_plot_svg(input, outcome));
+  for (const jobs::FitSkip& skip : outcome.skipped) {
+    v1::FitSkipped* out = report.add_skipped();
+    out->set_model(model_name(skip.model));
+    out->set_reason(skip.reason);
+  }
   return report;
 }
 
 Result<jobs::FitOutcome> fit_outcome_from_report(const jobs::FitInput& input, const v1::FitReport& report) {
-  if (static_cast<size_t>(report.fits_size()) != input.models.size())
-    return fail("the fit report has " + std::to_string(report.fits_size()) + " fit(s), " +
-                std::to_string(input.models.size()) + " were asked for");
   jobs::FitOutcome outcome;
+  // The models fitted: those asked for, in order, less the ones the report says were skipped.
+  std::vector<MaterialModel> fitted_models;
+  for (const MaterialModel model : input.models) {
+    const auto skipped = std::find_if(report.skipped().begin(), report.skipped().end(),
+                                      [&](const v1::FitSkipped& skip) { return skip.model() == model_name(model); });
+    if (skipped == report.skipped().end()) {
+      fitted_models.push_back(model);
+    } else {
+      outcome.skipped.push_back({model, skipped->reason()});
+    }
+  }
+  if (static_cast<size_t>(report.fits_size()) != fitted_models.size() ||
+      outcome.skipped.size() != static_cast<size_t>(report.skipped_size()))
+    return fail("the fit report has " + std::to_string(report.fits_size()) + " fit(s) and " +
+                std::to_string(report.skipped_size()) + " skipped, " + std::to_string(input.models.size()) +
+                " were asked for");
   for (int m = 0; m < report.fits_size(); ++m) {
     const v1::FitModelReport& in = report.fits(m);
-    const MaterialModel model = input.models[static_cast<size_t>(m)];
+    const MaterialModel model = fitted_models[static_cast<size_t>(m)];
     if (in.model() != model_name(model))
       return fail("the fit report's model '" + in.model() + "' is not the " + model_name(model) + " fit asked for");
     FitResult fit;

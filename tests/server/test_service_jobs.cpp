@@ -141,6 +141,49 @@ TEST(ServiceJobs, FitReportReadsBackToTheSameTextPlotAndJson) {
   EXPECT_FALSE(service::fit_outcome_from_report(*input, no_constant).ok());
 }
 
+// "all" on data too short for Hart-Smith's three constants fits the two laws it can and says why it left
+// the third out (the whole command failed: "hart-smith: only 2 data points for the 3 parameters").
+TEST(ServiceJobs, AllFitsTheLawsTheDataCanFitAndNamesTheOneItLeftOut) {
+  std::vector<jobs::FitDataFile> files(1);
+  files[0].label = "two.csv";
+  files[0].csv_text = "stretch,nominal_stress_MPa\n1.2,0.2\n1.4,0.3\n";
+  files[0].test = "uniaxial";
+  const Result<jobs::FitInput> input = jobs::prepare_fit(files, "all");
+  ASSERT_TRUE(input.ok()) << input.error();
+  const Result<jobs::FitOutcome> fitted = jobs::run_fit(*input);
+  ASSERT_TRUE(fitted.ok()) << fitted.error();
+  ASSERT_EQ(fitted->fits.size(), 2u);
+  EXPECT_EQ(fitted->fits[0].material.model, MaterialModel::MooneyRivlin);
+  EXPECT_EQ(fitted->fits[1].material.model, MaterialModel::NeoHookean);
+  ASSERT_EQ(fitted->skipped.size(), 1u);
+  EXPECT_EQ(fitted->skipped[0].model, MaterialModel::HartSmith);
+  EXPECT_EQ(fitted->skipped[0].reason, "only 2 data points for the 3 parameters of hart-smith");
+  EXPECT_NE(jobs::fit_summary_text(*input, *fitted).find("hart-smith: not fitted: only 2 data points"), std::string::npos);
+  EXPECT_NE(jobs::fit_report_json(*input, *fitted).find(R"("model":"hart-smith","skipped":"only 2 data points)"),
+            std::string::npos)
+      << jobs::fit_report_json(*input, *fitted);
+  // Through the report (what the CLI reads back from a server): the same outcome.
+  const v1::FitReport report = service::fit_report(*input, *fitted);
+  ASSERT_EQ(report.skipped_size(), 1);
+  EXPECT_EQ(report.skipped(0).model(), "hart-smith");
+  Result<jobs::FitOutcome> read = service::fit_outcome_from_report(*input, report);
+  ASSERT_TRUE(read.ok()) << read.error();
+  read->time_s = fitted->time_s;
+  EXPECT_EQ(jobs::fit_summary_text(*input, *read), jobs::fit_summary_text(*input, *fitted));
+  // One model asked for by name still fails on such data, and so does "all" when no law fits.
+  const Result<jobs::FitInput> hart_smith = jobs::prepare_fit(files, "hart-smith");
+  ASSERT_TRUE(hart_smith.ok());
+  const Result<jobs::FitOutcome> refused = jobs::run_fit(*hart_smith);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.error(), "hart-smith: only 2 data points for the 3 parameters of hart-smith");
+  files[0].csv_text = "stretch,nominal_stress_MPa\n1.2,0\n1.4,0\n";
+  const Result<jobs::FitInput> zeros = jobs::prepare_fit(files, "all");
+  ASSERT_TRUE(zeros.ok()) << zeros.error();
+  const Result<jobs::FitOutcome> none = jobs::run_fit(*zeros);
+  ASSERT_FALSE(none.ok());
+  EXPECT_EQ(none.error().rfind("no law fits this data (hart-smith: ", 0), 0u) << none.error();
+}
+
 TEST(ServiceJobs, BadFitJobsAreRefusedAtSubmitAndPresetsCannotBeOverwritten) {
   ScratchDir scratch;
   ServerProcess server(scratch.file("jobs.db"), {"--workers", "1"});

@@ -110,6 +110,14 @@ export class FitPanel {
         `(${format_number(100 * (fit.rms_relative_residual ?? NaN), 3)} %)`;
       row.insertCell().textContent = String(fit.points ?? '–');
     }
+    // "all" leaves out the laws the data cannot fit (too few points for their constants), saying why.
+    for (const skipped of result.fit_report?.skipped ?? []) {
+      const row = table.insertRow();
+      row.insertCell().textContent = skipped.model ?? '?';
+      const reason = row.insertCell();
+      reason.colSpan = 3;
+      reason.textContent = `not fitted: ${skipped.reason ?? ''}`;
+    }
     const url = await this.m_api.fetch_svg_url(job_id, 'fit.svg');
     if (this.m_plot_url) URL.revokeObjectURL(this.m_plot_url);
     this.m_plot_url = url;
