@@ -667,9 +667,8 @@ class SceneMerger {
 
   /// A polygon face (a PLY's quads) split into triangles, in the mirrored winding when `mirrored`.
   void append_polygon(const aiMesh& mesh, const aiFace& face, const std::vector<int>& welded, bool mirrored) {
-    if (face.mNumIndices > static_cast<unsigned>(MAX_POLYGON_CORNERS)) {
-      m_error = "face " + std::to_string(m_face_index) + " has " + std::to_string(face.mNumIndices) +
-                " vertices; polygons of up to " + std::to_string(MAX_POLYGON_CORNERS) + " are split into triangles";
+    if (const std::string problem = polygon_corner_problem(face.mNumIndices); !problem.empty()) {
+      m_error = "face " + std::to_string(m_face_index) + " " + problem;
       return;
     }
     std::vector<int> corners;

@@ -116,14 +116,6 @@ TriMesh to_mesh(const std::vector<double>& coordinates, const std::vector<int>& 
   return mesh;
 }
 
-/// Why a face of `corners` corners cannot be read (fewer than 3, more than MAX_POLYGON_CORNERS), or "".
-std::string polygon_corner_problem(long corners) {
-  if (corners >= 3 && corners <= MAX_POLYGON_CORNERS) return "";
-  if (corners < 3) return "has " + std::to_string(corners) + " vertices; a face needs at least 3";
-  return "has " + std::to_string(corners) + " vertices; polygons of up to " + std::to_string(MAX_POLYGON_CORNERS) +
-         " are split into triangles";
-}
-
 /// Appends `face` to `indices` as triangles (append_polygon_triangles); false when they would pass
 /// `max_faces` (0: no limit).
 bool append_face(const std::vector<int>& face, const std::vector<double>& coordinates, std::vector<int>& indices,

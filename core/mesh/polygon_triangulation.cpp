@@ -17,6 +17,13 @@ bool inside_or_on(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eige
 
 }  // namespace
 
+std::string polygon_corner_problem(long corners) {
+  if (corners >= 3 && corners <= MAX_POLYGON_CORNERS) return "";
+  if (corners < 3) return "has " + std::to_string(corners) + " vertices; a face needs at least 3";
+  return "has " + std::to_string(corners) + " vertices; polygons of up to " + std::to_string(MAX_POLYGON_CORNERS) +
+         " are split into triangles";
+}
+
 std::vector<std::array<int, 3>> triangulate_polygon(const std::vector<Eigen::Vector3d>& corners) {
   const int n = static_cast<int>(corners.size());
   std::vector<std::array<int, 3>> triangles;

@@ -3,6 +3,7 @@
 /// into the triangles the membrane model is built on.
 #include <Eigen/Core>
 #include <array>
+#include <string>
 #include <vector>
 
 namespace balloon {
@@ -10,6 +11,10 @@ namespace balloon {
 /// The most corners a polygon face may have (real meshes' caps have tens to a couple of hundred); a
 /// hostile face of a million corners is refused before any work.
 constexpr int MAX_POLYGON_CORNERS = 256;
+
+/// Why a face of `corners` corners cannot be read (fewer than 3, more than MAX_POLYGON_CORNERS), as the
+/// rest of a sentence about the face ("has 2 vertices; a face needs at least 3"), or "".
+std::string polygon_corner_problem(long corners);
 
 /// Splits a polygon face into corners - 2 triangles of the face's own winding, as index triples into
 /// `corners` (positions in the face's order, at least 3, at most MAX_POLYGON_CORNERS). Ear clipping in
