@@ -263,7 +263,7 @@ std::string measurement_problem(const MeasurementSet& set) {
     if (auto problem = thickness_problem(set.thickness_mm); !problem.empty()) return "bulge data: disc " + problem;
     // The disc's rest shape is as wide as the opening: the balloon's thin-sheet rule, on its diameter.
     const double diameter_mm = 2.0 * set.disc_radius_mm;
-    if (set.thickness_mm > MAX_THICKNESS_PER_DIAGONAL * diameter_mm * (1.0 + THIN_SHEET_SLACK))
+    if (!within_thin_sheet_limit(set.thickness_mm, diameter_mm))
       return "bulge data: a disc " + number_text(set.thickness_mm) + " mm thick over an opening of radius " +
              number_text(set.disc_radius_mm) + " mm is no thin sheet: the membrane model needs the thickness at most " +
              number_text(100.0 * MAX_THICKNESS_PER_DIAGONAL) + "% of the opening's diameter (" +

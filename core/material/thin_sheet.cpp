@@ -13,12 +13,16 @@ std::string thickness_problem(double thickness_mm) {
   return out.str();
 }
 
+bool within_thin_sheet_limit(double thickness_mm, double size_mm) {
+  return !(thickness_mm > MAX_THICKNESS_PER_DIAGONAL * size_mm * (1.0 + THIN_SHEET_SLACK));
+}
+
 std::string thin_sheet_problem(double thickness_mm, double rest_diagonal_mm) {
   // 10% is the model's rule of thumb, not a sharp edge, so it has 2% slack: a design target is checked at
   // the size the user gave, and its remeshed surface, which lies inside the given one, is a little smaller
   // (a 10 mm target at 1,500 vertices: 4.99 mm at the start instead of 5). Without the slack, a design at
   // the limit passed at submit and was refused by the job as `start_failed`.
-  if (!(thickness_mm > MAX_THICKNESS_PER_DIAGONAL * rest_diagonal_mm * (1.0 + THIN_SHEET_SLACK))) return "";
+  if (within_thin_sheet_limit(thickness_mm, rest_diagonal_mm)) return "";
   std::ostringstream out;
   out.precision(3);
   const double percent = 100.0 * (thickness_mm / rest_diagonal_mm);

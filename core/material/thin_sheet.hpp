@@ -12,6 +12,10 @@ constexpr double MAX_THICKNESS_PER_DIAGONAL = 0.1;
 /// Relative slack on that limit (see thin_sheet_problem): a sheet up to 10.2% passes.
 constexpr double THIN_SHEET_SLACK = 0.02;
 
+/// Whether a sheet `thickness_mm` thick on a rest shape `size_mm` across is within the thin-sheet limit
+/// (MAX_THICKNESS_PER_DIAGONAL, with THIN_SHEET_SLACK): the one rule for balloons and bulge discs.
+bool within_thin_sheet_limit(double thickness_mm, double size_mm);
+
 /// Why a sheet `thickness_mm` thick on a rest shape `rest_diagonal_mm` across (bounding-box diagonal) is
 /// not a thin sheet, naming both sizes and the remedy; "" when it is one.
 std::string thin_sheet_problem(double thickness_mm, double rest_diagonal_mm);
