@@ -412,6 +412,26 @@ TEST(Inflation, FlatFacedBoxInflatesFromZeroPressure) {
   EXPECT_LT(result.volume_ratio, 1.01);
 }
 
+TEST(Inflation, PressureFarBelowTheFirstStepsFindsHowFarTheFlatFacesBulge) {
+  // 0.001 kPa on the 100 mm cube: the path's first volume step (x1.5) has over a thousand times that
+  // pressure, and a flat face's pressure grows as the cube of the added volume, so the equilibrium lies
+  // near x1.15, not where a straight line from the rest points (x1.0004, a nearly slack sheet whose
+  // solves crept: 254 Newton steps before the bracket interpolated on that power law).
+  auto mesh = read_mesh(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/cube_866.off");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  mesh->vertices *= 100.0 / bounding_box_diagonal(mesh->vertices);
+  InflationOptions options;
+  options.material = *parse_material_spec("mooney-rivlin:C1=0.18,C2=0.02");
+  options.control = InflationControl::Pressure;
+  options.pressure_kpa = 0.001;
+  const InflationResult result = inflate(*mesh, options);
+  ASSERT_TRUE(result.converged) << result.message;
+  EXPECT_NEAR(result.pressure_kpa, 0.001, 1e-12);
+  EXPECT_GT(result.volume_ratio, 1.1);
+  EXPECT_LT(result.volume_ratio, 1.2);
+  EXPECT_LE(result.newton_iterations, 150);
+}
+
 TEST(Inflation, ALongStepReportsItsNewtonIterationsAsItGoes) {
   // The cube to x8: several volume steps of several Newton iterations each. With no interval, every
   // iteration that goes on is one "newton" event (its index counted over the run), and every step
