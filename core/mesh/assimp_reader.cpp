@@ -416,6 +416,11 @@ std::string check_ply_header(std::string_view bytes, const MeshReadLimits& limit
       if (words.size() != 3 || !is_ply_name(words[1]) || !parse_count(words[2], count)) {
         return where + "expected 'element NAME COUNT'";
       }
+      // assimp 5.2 sizes the vertex array from one 'element vertex' and fills it from another: a header
+      // declaring 12 vertices of x only, then 13 of x y z, wrote past the array's end (fuzz_mesh_ply).
+      if (std::any_of(elements.begin(), elements.end(), [&](const PlyElement& e) { return e.name == words[1]; })) {
+        return where + "element " + quoted(words[1]) + " is declared twice";
+      }
       if (words[1] == "vertex") vertex_count = count;
       if (words[1] == "face") face_count = count;
       if (!elements.empty() && elements.back().count > 0 && elements.back().properties.empty()) {

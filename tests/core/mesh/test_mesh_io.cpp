@@ -680,6 +680,12 @@ TEST(MeshIoHostile, InputsThatAssimpMishandlesAreRefusedBeforeIt) {
   ASSERT_FALSE(found.ok());
   expect_contains(found.error(), {"bad PLY data: line 519", "'+-1' is not a float"});
   ASSERT_TRUE(read_mesh_from_memory(ply_header + "0 0 0\n1 0 0\n0 +1 1\n3 0 1 2\n", "ply").ok());
+  // Found by fuzz_mesh_ply in session 43's CI (valgrind named the input; ASan saw only a corrupt heap later):
+  // 'element vertex 12' with x only, then 'element vertex 13' with x y z. assimp 5.2 sized its vertex
+  // array from one and wrote the other's past its end.
+  const auto twice = read_mesh_from_memory(read_bytes(std::string(BALLOON_FUZZ_REGRESSIONS_DIR) + "/ply-overflow-70659735.ply"), "ply");
+  ASSERT_FALSE(twice.ok());
+  expect_contains(twice.error(), {"bad PLY header: line 7", "element 'vertex' is declared twice"});
   // Lines out of step with the header: assimp read a coordinate as a face's list length, and leaked.
   const auto short_line = read_mesh_from_memory(ply_header + "0 0 0\n1 0\n0 1 0\n3 0 1 2\n", "ply");
   ASSERT_FALSE(short_line.ok());
