@@ -105,6 +105,8 @@ Result<std::unique_ptr<GrpcServer>> GrpcServer::start(const ServerConfig& config
 int GrpcServer::port() const { return m_internals->port; }
 int GrpcServer::recovered_jobs() const { return m_internals->recovered; }
 
+int GrpcServer::running_jobs() const { return m_internals->jobs->running_count(); }
+
 std::shared_ptr<grpc::Channel> GrpcServer::in_process_channel() {
   grpc::ChannelArguments arguments;
   arguments.SetMaxReceiveMessageSize(-1);

@@ -37,6 +37,8 @@ class GrpcServer {
   std::shared_ptr<grpc::Channel> in_process_channel();
   /// Jobs re-queued from the store at start.
   int recovered_jobs() const;
+  /// Jobs running on the workers now (the benches' "every worker busy").
+  int running_jobs() const;
 
   /// Tells health checks (grpc.health.v1, service "") NOT_SERVING from now on: the first step of a drain.
   void report_not_serving();

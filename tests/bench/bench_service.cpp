@@ -1,6 +1,9 @@
 /// Service benchmark: an in-process balloon server on 127.0.0.1:0 (real TCP on loopback) with N workers,
 /// K client threads each submitting J small simulate jobs (icosphere, subdivision 2) one after the other
-/// and watching each to its end. With K > N every worker stays busy while others submit. Each client connects
+/// and watching each to its end. With K > N the workers are busy most of the time while others submit; a
+/// call counts as made with every worker busy when the server's count of running jobs says so as the call is
+/// made (between two jobs a worker is briefly free, often just as a client submits its next job, so only
+/// about half the calls count). Each client connects
 /// its channel first (the TCP and HTTP/2 handshakes, timed on their own) and sends a request_id with every
 /// submission, as the CLI does. Prints SubmitJob
 /// latency and progress-event latency (client receive time minus the server's event stamp, JobEvent.time_ms,
@@ -98,7 +101,7 @@ int int_flag(int argc, char** argv, const char* name, int fallback) {
 struct ClientStats {
   std::vector<double> submit_ms;        ///< SubmitJob round trip (ms)
   std::vector<double> submit_busy_ms;   ///< the same, of the calls made while every worker was busy (ms)
-  std::vector<double> later_busy_ms;    ///< the same without each client's first call (all clients at once)
+  std::vector<double> first_call_ms;   ///< each client's first call: the start burst, all clients at once (ms)
   double connect_ms = 0;                ///< the channel's connect, before the first call (ms)
   std::vector<double> event_latency_ms; ///< receive wall time - JobEvent.time_ms, progress events only (ms)
   std::vector<double> interarrival_ms;  ///< time between consecutive progress events of one stream (ms)
@@ -168,7 +171,6 @@ int main(int argc, char** argv) {
   job->set_thickness_mm(0.5);
   job->set_pressure_kpa(18.0);  // a pressure walk: several progress events per job
 
-  std::atomic<int> running_jobs{0};
   std::vector<ClientStats> stats(static_cast<size_t>(clients));
   std::vector<std::thread> threads;
   const auto start = Clock::now();
@@ -188,15 +190,18 @@ int main(int argc, char** argv) {
         mine_request.set_request_id("bench-" + std::to_string(c) + "-" + std::to_string(j));
         v1::SubmitJobResponse submitted;
         grpc::ClientContext submit_context;
+        // Whether every worker was busy when the call was made, by the server's own count (read before
+        // the call: the start burst's first calls were made while the workers were still idle).
+        const bool made_busy = (*server)->running_jobs() >= workers;
         const auto before = Clock::now();
         const grpc::Status status = stub->SubmitJob(&submit_context, mine_request, &submitted);
         const double submit_ms = std::chrono::duration<double, std::milli>(Clock::now() - before).count();
         mine.submit_ms.push_back(submit_ms);
-        if (running_jobs.load() >= workers) {
+        if (made_busy) {
           ++mine.busy_samples;
           mine.submit_busy_ms.push_back(submit_ms);
-          if (j > 0) mine.later_busy_ms.push_back(submit_ms);
         }
+        if (j == 0) mine.first_call_ms.push_back(submit_ms);
         if (!status.ok()) {
           ++mine.failed;
           continue;
@@ -207,17 +212,12 @@ int main(int argc, char** argv) {
         watch.set_job_id(submitted.job().id());
         auto reader = stub->WatchJob(&watch_context, watch);
         v1::JobEvent event;
-        bool counted_running = false;
         Clock::time_point last_progress{};
         v1::JobState last_state = v1::JOB_STATE_UNSPECIFIED;
         while (reader->Read(&event)) {
           const std::int64_t received = wall_ms();
           ++mine.events;
           last_state = event.state();
-          if (event.state() == v1::JOB_STATE_RUNNING && !counted_running) {
-            counted_running = true;
-            ++running_jobs;
-          }
           if (!event.has_progress() || event.state() != v1::JOB_STATE_RUNNING || event.time_ms() == 0) continue;
           if (event.has_mesh()) ++mine.mesh_events;
           mine.event_latency_ms.push_back(static_cast<double>(received - event.time_ms()));
@@ -227,7 +227,6 @@ int main(int argc, char** argv) {
           last_progress = now;
         }
         reader->Finish();
-        if (counted_running) --running_jobs;
         if (last_state == v1::JOB_STATE_COMPLETED)
           ++mine.completed;
         else
@@ -246,7 +245,7 @@ int main(int argc, char** argv) {
   for (const ClientStats& one : stats) {
     all.submit_ms.insert(all.submit_ms.end(), one.submit_ms.begin(), one.submit_ms.end());
     all.submit_busy_ms.insert(all.submit_busy_ms.end(), one.submit_busy_ms.begin(), one.submit_busy_ms.end());
-    all.later_busy_ms.insert(all.later_busy_ms.end(), one.later_busy_ms.begin(), one.later_busy_ms.end());
+    all.first_call_ms.insert(all.first_call_ms.end(), one.first_call_ms.begin(), one.first_call_ms.end());
     all.event_latency_ms.insert(all.event_latency_ms.end(), one.event_latency_ms.begin(), one.event_latency_ms.end());
     all.interarrival_ms.insert(all.interarrival_ms.end(), one.interarrival_ms.begin(), one.interarrival_ms.end());
     connect_ms.push_back(one.connect_ms);
@@ -261,10 +260,11 @@ int main(int argc, char** argv) {
   std::printf("SubmitJob latency (ms): p50 %.2f  p99 %.2f  max %.2f  over %zu calls (%d made with every worker busy)\n",
               percentile(all.submit_ms, 0.5), percentile(all.submit_ms, 0.99), percentile(all.submit_ms, 1.0),
               all.submit_ms.size(), all.busy_samples);
-  std::printf("SubmitJob with every worker busy (ms): p99 %.2f; without each client's first call (the %d clients' "
-              "burst at the start): p99 %.2f over %zu calls\n",
-              percentile(all.submit_busy_ms, 0.99), clients, percentile(all.later_busy_ms, 0.99),
-              all.later_busy_ms.size());
+  std::printf("SubmitJob made with every worker busy (the server's count of running jobs as the call is made; "
+              "ms): p99 %.2f; the start burst (each client's first call, all %d at once, made while the "
+              "workers were still idle or starting): p99 %.2f  max %.2f\n",
+              percentile(all.submit_busy_ms, 0.99), clients, percentile(all.first_call_ms, 0.99),
+              percentile(all.first_call_ms, 1.0));
   std::printf("channel connect, before the first call (ms): p50 %.2f  max %.2f  over %zu clients\n",
               percentile(connect_ms, 0.5), percentile(connect_ms, 1.0), connect_ms.size());
   std::printf("progress-event latency, server stamp -> client (ms, 1 ms resolution): p50 %.0f  p99 %.0f  max %.0f  over %zu events (%d with meshes)\n",
@@ -277,6 +277,7 @@ int main(int argc, char** argv) {
   std::printf("\n%-44s %12s %12s  %s\n", "issue 14", "target", "measured", "");
   std::printf("%-44s %12s %9.2f ms  %s\n", "SubmitJob p99, every worker busy", "<= 5 ms", submit_p99,
               submit_p99 <= 5.0 ? "met" : "NOT met");
+  std::printf("%-44s %12s %9.2f ms\n", "SubmitJob p99, all calls (with the burst)", "", percentile(all.submit_ms, 0.99));
   std::printf("%-44s %12s %9.0f ms  %s\n", "progress-event latency p99", "<= 20 ms", event_p99,
               event_p99 <= 20.0 ? "met" : "NOT met");
   std::printf("%-44s %12s %9.1f MB\n", "peak memory (server and clients)", "", peak_memory_mb());

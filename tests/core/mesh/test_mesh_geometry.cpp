@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <stdexcept>
 #include <string>
 
@@ -63,6 +64,23 @@ TEST(MeshGeometry, MinAngleOfSampleMeshesMatchesProvenance) {
     const auto mesh = read_mesh(test::sample_mesh(name));
     ASSERT_TRUE(mesh.ok()) << mesh.error();
     EXPECT_NEAR(min_angle_deg(mesh->vertices, mesh->faces), angle, 0.01 + 0.005 * angle) << name;
+  }
+}
+
+TEST(MeshGeometry, MinAngleIsTheSmallestCornerAngleOnEveryCorpusMesh) {
+  // min_angle_deg takes the corner opposite each face's shortest edge; every corner's angle, including the
+  // anchor's 0.001-degree slivers, must give the same minimum.
+  for (const auto& entry : std::filesystem::directory_iterator(test::sample_mesh(""))) {
+    const std::string extension = entry.path().extension().string();
+    if (extension != ".off" && extension != ".obj") continue;
+    const auto mesh = read_mesh(entry.path().string());
+    ASSERT_TRUE(mesh.ok()) << mesh.error();
+    double every_corner = 180.0;
+    for (Eigen::Index f = 0; f < mesh->faces.rows(); ++f)
+      for (const double angle : corner_angles_deg(mesh->vertices, mesh->faces.row(f).transpose()))
+        every_corner = std::min(every_corner, angle);
+    EXPECT_NEAR(min_angle_deg(mesh->vertices, mesh->faces), every_corner, 1e-12 * (1.0 + every_corner))
+        << entry.path().filename();
   }
 }
 
