@@ -31,10 +31,16 @@ std::vector<FieldProblem> simulate_parameter_problems(const SimulateParameters& 
                                                          : "give either a pressure or a volume ratio, not both"});
   else if (controls == 0)
     problems.push_back({"pressure_kpa", "give a pressure (kPa) or a volume ratio (or a curve range)"});
-  else if (parameters.pressure_kpa && (!std::isfinite(*parameters.pressure_kpa) || *parameters.pressure_kpa <= 0.0))
-    problems.push_back({"pressure_kpa", "pressure must be a positive number of kPa, got " + format_number(*parameters.pressure_kpa)});
-  else if (parameters.volume_ratio && (!std::isfinite(*parameters.volume_ratio) || *parameters.volume_ratio <= 0.0))
-    problems.push_back({"volume_ratio", "volume ratio must be a positive number, got " + format_number(*parameters.volume_ratio)});
+  // A single run has the bounds of a curve's range (a ratio of 1e308 ran into the solver and came back as
+  // "non-finite residual").
+  else if (parameters.pressure_kpa && !(*parameters.pressure_kpa > 0.0 && *parameters.pressure_kpa <= MAX_CURVE_PRESSURE_KPA))
+    problems.push_back({"pressure_kpa", "pressure must be a positive number of kPa up to " +
+                                            format_number(MAX_CURVE_PRESSURE_KPA) + ", got " +
+                                            format_number(*parameters.pressure_kpa)});
+  else if (parameters.volume_ratio && !(*parameters.volume_ratio > 0.0 && *parameters.volume_ratio <= MAX_CURVE_VOLUME_RATIO))
+    problems.push_back({"volume_ratio", "volume ratio must be a positive number up to " +
+                                            format_number(MAX_CURVE_VOLUME_RATIO) + ", got " +
+                                            format_number(*parameters.volume_ratio)});
   else if (parameters.curve) {
     const CurveParameters* curve = &*parameters.curve;
     // The range and the point count each by their own field: check the range with a valid count.
