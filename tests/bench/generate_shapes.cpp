@@ -36,7 +36,12 @@ int main(int argc, char** argv) {
     return usage();
   }
   const std::filesystem::path meshes = std::filesystem::path(out_dir) / "meshes";
-  std::filesystem::create_directories(meshes);
+  std::error_code error;
+  std::filesystem::create_directories(meshes, error);
+  if (error) {
+    std::fprintf(stderr, "generate_shapes: cannot create %s: %s\n", meshes.string().c_str(), error.message().c_str());
+    return 1;
+  }
   std::ofstream provenance(meshes / "PROVENANCE.md");
   provenance << "# Generated shapes\n\n`generate_shapes " << out_dir << " --seed " << seed << " --size " << size
              << "`: implicit surfaces meshed by CGAL's surface mesher (angle 25 degrees, size " << size
