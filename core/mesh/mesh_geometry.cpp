@@ -70,12 +70,12 @@ double min_angle_deg(const Positions& vertices, const Faces& faces) {
   for (Eigen::Index f = 0; f < faces.rows(); ++f) {
     const std::array<Eigen::RowVector3d, 3> corner{vertices.row(faces(f, 0)), vertices.row(faces(f, 1)),
                                                    vertices.row(faces(f, 2))};
-    // edge[k] runs from corner k+1 to corner k+2: the edge opposite corner k.
-    std::array<double, 3> length2{};
-    for (int k = 0; k < 3; ++k) length2[static_cast<size_t>(k)] = (corner[(k + 2) % 3] - corner[(k + 1) % 3]).squaredNorm();
-    const int k = static_cast<int>(std::min_element(length2.begin(), length2.end()) - length2.begin());
-    const Eigen::RowVector3d u = corner[static_cast<size_t>((k + 1) % 3)] - corner[static_cast<size_t>(k)];
-    const Eigen::RowVector3d w = corner[static_cast<size_t>((k + 2) % 3)] - corner[static_cast<size_t>(k)];
+    // The squared length of the edge opposite each corner.
+    std::array<double, 3> opposite{};
+    for (std::size_t k = 0; k < 3; ++k) opposite[k] = (corner[(k + 2) % 3] - corner[(k + 1) % 3]).squaredNorm();
+    const auto k = static_cast<std::size_t>(std::min_element(opposite.begin(), opposite.end()) - opposite.begin());
+    const Eigen::RowVector3d u = corner[(k + 1) % 3] - corner[k];
+    const Eigen::RowVector3d w = corner[(k + 2) % 3] - corner[k];
     min_angle = std::min(min_angle, std::atan2(u.cross(w).norm(), u.dot(w)) * 180.0 / std::numbers::pi);
   }
   return min_angle;
