@@ -286,14 +286,17 @@ bool DesignDriver::restore_best(Eigen::VectorXd& rest) {
   // the smallest average surface error seen (the log still shows every iterate).
   if (m_best_error < std::numeric_limits<double>::infinity() && m_best_rest.size() == rest.size()) {
     const double current = m_objective.surface().aligned_stats(unflatten(m_x), m_target.vertices).avg_mm;
-    if (m_best_error < current) {
-      rest = m_best_rest;
-      m_x = m_best_x;
-      m_pressure = m_best_pressure;
-      return true;
-    }
+    if (m_best_error < current) return restore_best_equilibrium(rest);
   }
   return false;
+}
+
+bool DesignDriver::restore_best_equilibrium(Eigen::VectorXd& rest) {
+  if (!(m_best_error < std::numeric_limits<double>::infinity()) || m_best_rest.size() != rest.size()) return false;
+  rest = m_best_rest;
+  m_x = m_best_x;
+  m_pressure = m_best_pressure;
+  return true;
 }
 
 DesignResult& DesignDriver::finish(DesignResult& result, const Eigen::VectorXd& rest) {

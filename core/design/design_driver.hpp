@@ -88,6 +88,9 @@ class DesignDriver {
   /// Goes back to the best design seen when its average surface error is below the current one's; true
   /// when it did.
   bool restore_best(Eigen::VectorXd& rest);
+  /// Goes back to the best design seen whatever the current shape's error (it is no equilibrium); false
+  /// when none was recorded.
+  bool restore_best_equilibrium(Eigen::VectorXd& rest);
   /// Whether the returned shape is an equilibrium (alm: whether its final re-inflation converged).
   void set_final_equilibrium(bool converged) { m_final_equilibrium = converged; }
   /// The result's shapes and errors. Without an inflated start (start_failed, or stopped before it)
