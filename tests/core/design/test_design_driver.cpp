@@ -72,5 +72,28 @@ TEST(DesignDriver, RestoreBestHandsBackTheStartWhenTheCurrentShapeIsFartherFromT
   EXPECT_EQ(driver.x(), start_x);
 }
 
+TEST(DesignDriver, RestoreBestEquilibriumHandsBackTheStartEvenWhereTheCurrentShapeLooksCloser) {
+  // The augmented Lagrangian's final inflation may find no equilibrium: whatever its unbalanced shape's
+  // error, the start (a true equilibrium) comes back.
+  const TriMesh target = design_test::inflated_ellipsoid_target(2, 1.0);
+  const DesignOptions options = ellipsoid_options(DesignMethod::AugmentedLagrangian);
+  DesignDriver driver(target, options);
+  DesignResult result = driver.begin(DesignMethod::AugmentedLagrangian);
+  Eigen::VectorXd rest = flat(driver.start().vertices);
+  EXPECT_FALSE(driver.restore_best_equilibrium(rest)) << "nothing recorded before the start is inflated";
+  const Eigen::VectorXd start = rest;
+  ASSERT_TRUE(driver.inflate_start(start, result)) << result.message;
+  const Eigen::VectorXd start_x = driver.x();
+  const double start_pressure = driver.pressure();
+
+  rest = 1.01 * start;
+  driver.x() = flat(target.vertices);  // on the target itself: closer than any equilibrium, but unbalanced
+  EXPECT_FALSE(driver.restore_best(rest)) << "restore_best keeps a closer shape";
+  EXPECT_TRUE(driver.restore_best_equilibrium(rest));
+  EXPECT_EQ(rest, start);
+  EXPECT_EQ(driver.x(), start_x);
+  EXPECT_EQ(driver.pressure(), start_pressure);
+}
+
 }  // namespace
 }  // namespace balloon
