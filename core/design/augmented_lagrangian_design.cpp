@@ -187,14 +187,17 @@ class AugmentedLagrangianDesign {
     m_x = x;
     m_pressure = inflated_pressure;
     m_driver.set_final_equilibrium(m_last_report.converged);
+    // Optimal held for the ALM iterate, not for the start handed back instead of it.
+    auto start_handed_back = [&](const std::string& why) {
+      if (result.stop == DesignStop::Optimal) stop_with(result, DesignStop::Stalled, "stalled: " + why);
+      else result.message += "; " + why;
+    };
     if (!m_last_report.converged) {
       const std::string not_balanced = "the final rest shape did not reach equilibrium (" + m_last_report.message + ")";
       // Its shape would be no balloon's: the start, a true equilibrium, is handed back instead.
       if (m_driver.restore_best_equilibrium(rest)) {
         m_driver.set_final_equilibrium(true);
-        const std::string handed_back = not_balanced + "; the start is handed back";
-        if (result.stop == DesignStop::Optimal) stop_with(result, DesignStop::Stalled, "stalled: " + handed_back);
-        else result.message += "; " + handed_back;
+        start_handed_back(not_balanced + "; the start is handed back");
       } else {
         result.message += "; " + not_balanced;
       }
@@ -202,10 +205,7 @@ class AugmentedLagrangianDesign {
       // As the adjoint method hands back its best design: the start is a true equilibrium too, and an ALM
       // result that inflates farther from the target is no better design (cactus, latex, 10 s: 3.22 mm
       // against the start's 3.10 mm).
-      const std::string handed_back = "its final rest shape inflated farther from the target than the start, which is handed back";
-      // Optimal held for the ALM iterate, not for what is handed back.
-      if (result.stop == DesignStop::Optimal) stop_with(result, DesignStop::Stalled, "stalled: " + handed_back);
-      else result.message += "; " + handed_back;
+      start_handed_back("its final rest shape inflated farther from the target than the start, which is handed back");
     }
     return m_driver.finish(result, rest);
   }
