@@ -43,6 +43,16 @@ Database::~Database() {
   sqlite3_close_v2(m_db);
 }
 
+void Database::count_wal_frames() {
+  sqlite3_wal_hook(
+      m_db,
+      [](void* self, sqlite3*, const char*, int frames) {
+        static_cast<Database*>(self)->m_wal_frames.store(frames, std::memory_order_relaxed);
+        return SQLITE_OK;
+      },
+      this);
+}
+
 void Database::execute(std::string_view sql) {
   char* message = nullptr;
   const std::string text(sql);

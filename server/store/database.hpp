@@ -1,6 +1,7 @@
 #pragma once
 /// A thin RAII layer over one SQLite connection: the connection, prepared statements and transactions.
 /// sqlite3.h stays in database.cpp; errors from SQLite throw DatabaseError (they are not user input).
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -52,6 +53,13 @@ class Database {
   void keep_wal_on_close();
   /// Makes a statement running on this connection (from another thread) stop soon with an error.
   void interrupt();
+  /// From now on, counts the pages (frames) in the WAL after each commit on this connection (SQLite's
+  /// WAL hook, which also drives its own automatic checkpoints: those stop; the owner checkpoints).
+  void count_wal_frames();
+  /// Pages in the WAL after the last commit on this connection (count_wal_frames; 0 before). A checkpoint
+  /// that copied the whole WAL lets the next commit start it over, so this falls back then, where the
+  /// WAL file's size does not.
+  int wal_frames() const { return m_wal_frames.load(std::memory_order_relaxed); }
   /// The path it was opened with.
   const std::string& path() const { return m_path; }
 
@@ -62,6 +70,7 @@ class Database {
 
   std::string m_path;
   sqlite3* m_db = nullptr;
+  std::atomic<int> m_wal_frames{0};
   /// Prepared statements not in use, by SQL text. A text in use twice at once gets a second, uncached one.
   std::unordered_map<std::string, sqlite3_stmt*> m_idle_statements;
 };

@@ -1,7 +1,12 @@
-// Unit tests of the SQLite connection's statement cache: a statement taken from the cache behaves like a
-// freshly prepared one (no bindings left, first row again), and one SQL text can be in use twice at once.
+// Unit tests of the SQLite connection: a statement taken from the cache behaves like a freshly prepared
+// one (no bindings left, first row again), one SQL text can be in use twice at once, and the WAL's page
+// count (which decides when the store checkpoints) falls back after a checkpoint.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <string>
+
+#include "scratch_dir.hpp"
 #include "store/database.hpp"
 
 namespace balloon::store {
@@ -60,6 +65,25 @@ TEST(Database, OneSqlTextCanBeInUseTwiceAtOnce) {
     while (inner.step()) ++pairs;
   }
   EXPECT_EQ(pairs, 3 + 2 + 1);
+}
+
+TEST(Database, TheWalPageCountFallsBackAfterACheckpointWhereTheWalFileDoesNot) {
+  balloon::testing::ScratchDir scratch("balloon-wal");
+  const std::string path = scratch.file("store.db");
+  Database writer(path, 5000, Synchronous::Normal);
+  writer.execute("PRAGMA wal_autocheckpoint = 0; CREATE TABLE blobs (b BLOB)");
+  writer.count_wal_frames();
+  const std::string half_megabyte(512 * 1024, 'x');
+  writer.prepare("INSERT INTO blobs (b) VALUES (?)").bind_blob(1, half_megabyte).run();
+  EXPECT_GE(writer.wal_frames(), 128);  // 4 KB pages
+  {
+    Database checkpointer(path, 5000, Synchronous::Normal);
+    checkpointer.execute("PRAGMA wal_checkpoint(PASSIVE)");
+  }
+  writer.prepare("INSERT INTO blobs (b) VALUES (?)").bind_blob(1, std::string("small")).run();
+  EXPECT_LE(writer.wal_frames(), 4);
+  // The file keeps its size (the log starts over inside it): not a measure of what is still to copy.
+  EXPECT_GE(std::filesystem::file_size(path + "-wal"), 512u * 1024u);
 }
 
 }  // namespace
