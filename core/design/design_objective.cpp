@@ -76,21 +76,21 @@ Eigen::VectorXd DesignObjective::shape_gradient(const Eigen::VectorXd& x) const 
 }
 
 /// E_surf = k_s L mean_i (d_i / diag)^2: the squared point-to-surface distances of the inflated
-/// vertices (the error the result reports), scaled like E_dist per mm of reference edge (L = total
-/// reference edge length, mm). Its gradient is 2 w (x_i - c_i) with c_i the closest target point
-/// (the derivative of a squared distance to a surface, wherever the closest point is unique).
+/// vertices at their Procrustes placement on the target (the error the result reports, in the same
+/// placement), scaled like E_dist per mm of reference edge (L = total reference edge length, mm). So it
+/// is rigid-invariant, as E_dist is. Its gradient is J_P^T 2 w (P_i - c_i) with c_i the closest target
+/// point (the derivative of a squared distance to a surface, wherever the closest point is unique).
 double DesignObjective::surface_term(const Eigen::VectorXd& x, Eigen::VectorXd* gradient) const {
   if (surface_weight_mm() <= 0.0) {
     if (gradient) gradient->setZero(x.size());
     return 0.0;
   }
-  // x is in the target's frame: the start's inflation is aligned onto the target, and the 6 pinned
-  // coordinates keep it there.
-  const Positions points = unflatten(x);
+  const ProcrustesPlacement placement(unflatten(x), m_target.vertices);
+  const Positions& points = placement.placed();
   Positions closest;
   Eigen::VectorXd distances;
   m_surface.closest_points(points, closest, &distances);
-  if (gradient) *gradient = 2.0 * surface_weight_mm() * flat(Positions(points - closest));
+  if (gradient) *gradient = placement.pull_back(2.0 * surface_weight_mm() * flat(Positions(points - closest)));
   return surface_weight_mm() * distances.squaredNorm();
 }
 
@@ -115,8 +115,7 @@ void DesignObjective::add_regularizer_gradient(const Eigen::VectorXd& rest, Eige
   if (m_max_volume_weight > 0.0) gradient -= m_max_volume_weight * m_model.volume_gradient(rest);
 }
 
-Positions DesignObjective::closest_target_normals(const Eigen::VectorXd& x) const {
-  const Positions points = unflatten(x);
+Positions DesignObjective::closest_target_normals(const Positions& points) const {
   Positions closest;
   Eigen::VectorXi faces;
   m_surface.closest_points(points, closest, nullptr, &faces);
@@ -136,17 +135,20 @@ ObjectiveGaussNewton DesignObjective::gauss_newton(const Eigen::VectorXd& x) con
   m_distance.residual_jacobian_triplets(x, entries);
   Eigen::SparseMatrix<double, Eigen::RowMajor> jacobian(m_distance.residual_count(), x.size());
   jacobian.setFromTriplets(entries.begin(), entries.end());
-  return ObjectiveGaussNewton(std::move(jacobian),
-                              surface_weight_mm() > 0.0 ? closest_target_normals(x) : Positions::Zero(0, 3),
-                              surface_weight_mm());
+  if (surface_weight_mm() <= 0.0) return ObjectiveGaussNewton(std::move(jacobian), Positions::Zero(0, 3), 0.0, nullptr);
+  auto placement = std::make_shared<const ProcrustesPlacement>(unflatten(x), m_target.vertices);
+  Positions normals = closest_target_normals(placement->placed());
+  return ObjectiveGaussNewton(std::move(jacobian), std::move(normals), surface_weight_mm(), std::move(placement));
 }
 
 /// Point-to-plane: 2 w n n^T per vertex with n the normal of the target triangle closest to it (sliding
-/// along the target costs nothing; E_dist governs that).
+/// along the target costs nothing; E_dist governs that), turned back into x's frame. Sparse, so without
+/// the placement's rank-6 coupling that gauss_newton() keeps.
 void DesignObjective::add_surface_hessian(const Eigen::VectorXd& x, std::vector<Eigen::Triplet<double>>& triplets,
                                           int dof_offset) const {
   if (surface_weight_mm() <= 0.0) return;
-  const Positions normals = closest_target_normals(x);
+  const ProcrustesPlacement placement(unflatten(x), m_target.vertices);
+  const Positions normals = closest_target_normals(placement.placed()) * placement.transform().rotation;
   for (Eigen::Index v = 0; v < normals.rows(); ++v) {
     const Eigen::Vector3d normal = normals.row(v).transpose();
     if (normal.isZero()) continue;

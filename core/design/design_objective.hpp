@@ -13,6 +13,7 @@
 #include "design/balloon_design.hpp"
 #include "design/distance_energy.hpp"
 #include "design/objective_gauss_newton.hpp"
+#include "design/procrustes_placement.hpp"
 #include "design/self_collision.hpp"
 #include "design/surface_distance.hpp"
 #include "fem/balloon_model.hpp"
@@ -62,8 +63,8 @@ class DesignObjective {
   void update_max_volume_term(const Eigen::VectorXd& rest, double start_distance, DesignResult& result);
 
   /// Moves the inflated shape x rigidly onto the target (vertex correspondence) when that moves it by
-  /// more than a 1e-4 of the diagonal on average, and says whether it did. Only E_surf cares where the
-  /// shape sits; the pinned coordinates otherwise keep the start's placement.
+  /// more than a 1e-4 of the diagonal on average, and says whether it did. No term's value changes (E_surf
+  /// is taken at that placement anyway); it keeps the pinned coordinates near the target.
   bool realign(Eigen::VectorXd& x) const;
 
   /// Active terms every method shares (the method adds its own).
@@ -75,9 +76,9 @@ class DesignObjective {
   bool rest_bending_active() const { return m_rest_bending_active; }
 
  private:
-  /// Per vertex of x, the unit normal of the target triangle closest to it (a zero row where that
-  /// triangle is degenerate).
-  Positions closest_target_normals(const Eigen::VectorXd& x) const;
+  /// Per point, the unit normal of the target triangle closest to it (a zero row where that triangle is
+  /// degenerate).
+  Positions closest_target_normals(const Positions& points) const;
   /// w of E_surf = w sum_i d_i^2 now (mm^-1); 0 when k_surface is 0.
   double surface_weight_mm() const { return m_k_surface * m_surface_growth_now * m_unit_surface_weight; }
   /// Hinges of `rest` whose dihedral angle moved more than a right angle from the start's.

@@ -1,6 +1,7 @@
 #include "design/reduced_space_design.hpp"
 
 #include <Eigen/SparseCore>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -13,6 +14,7 @@
 #include "design/distance_energy.hpp"
 #include "design/lbfgs.hpp"
 #include "design/reduced_gauss_newton.hpp"
+#include "solve/rigid_modes.hpp"
 #include "design/surface_distance.hpp"
 #include "solve/equilibrium_solver.hpp"
 
@@ -75,6 +77,7 @@ class ReducedSpaceDesign {
         m_surface(driver.objective().surface()),
         m_settings(driver.settings()),
         m_rest_free(driver.rest_free()),
+        m_all_rest_free(std::all_of(m_rest_free.begin(), m_rest_free.end(), [](bool free) { return free; })),
         m_target_volume(driver.target_volume()),
         m_x(driver.x()),
         m_pressure(driver.pressure()),
@@ -144,6 +147,11 @@ class ReducedSpaceDesign {
           direction = -gradient;
         }
       }
+      // Every term is blind to rigid motions of the rest shape, so a direction's rigid part (what the
+      // Gauss-Newton model's null space and its preconditioner leave in) gains nothing, but spends the trust
+      // radius and turns the balloon about its pinned coordinates: latex cactus's trials crept from the
+      // first iteration on and it stalled at the baseline; without it, 3.1x. A nozzle pins the rest shape.
+      if (m_all_rest_free) direction = without_rigid_motion(rest, direction);
       // Trust region on the rest shape: no vertex moves more than `radius` (at most 2% of the target's
       // size) per step. The radius shrinks to the last step that needed halving and grows back after
       // full steps, so a wrinkling region costs one failed equilibrium, not one per iteration.
@@ -180,6 +188,9 @@ class ReducedSpaceDesign {
           continue;
         }
         trial_objective = m_objective.value(trial_rest, trial_x);
+        if (std::getenv("BALLOON_DEBUG_DESIGN"))
+          std::fprintf(stderr, "    objective %.9g -> %.9g (change %.3g, asked %.3g, first order %.3g)\n", objective,
+                       trial_objective, trial_objective - objective, 1e-4 * t * slope, t * slope);
         if (trial_objective <= objective + 1e-4 * t * slope) {
           accepted = true;
           break;
@@ -224,9 +235,10 @@ class ReducedSpaceDesign {
       m_x = trial_x;
       m_pressure = trial_pressure;
       const bool collisions_changed = m_objective.update_collisions(rest, result);
-      // Re-placed on the target after every step: the six pinned coordinates otherwise keep the start's
-      // placement, and E_surf (not rigid-invariant) then fights E_dist (rigid-invariant) for it, a
-      // false minimum where a matchable target stalled at 4e-4 of its size (rounding decided which run).
+      // Re-placed on the target after every step (vertex correspondence, the result's placement). E_surf
+      // is taken at that placement (rigid-invariant, as E_dist is), so no term changes; when it was taken
+      // at the pinned placement, E_surf fought E_dist for it (a matchable target stalled at 4e-4 of its
+      // size), and each re-placement undid what the step had gained (latex blobby: 2-9% of the objective).
       const bool realigned = m_objective.realign(m_x);
       Eigen::VectorXd new_gradient;
       // The line search already evaluated this point; only a changed set of colliding pairs or a
@@ -365,6 +377,7 @@ class ReducedSpaceDesign {
   const SurfaceDistance& m_surface;
   const NewtonSettings& m_settings;
   const std::vector<bool>& m_rest_free;
+  const bool m_all_rest_free;  ///< no nozzle holds rest vertices
   const double m_target_volume;
   Eigen::VectorXd& m_x;           ///< the driver's current equilibrium
   double& m_pressure;

@@ -94,28 +94,82 @@ TEST(DesignObjective, AGrowthBelowOneIsRefused) {
   }
 }
 
-TEST(DesignObjective, ItsGaussNewtonOperatorMultipliesLikeTheAssembledMatrix) {
+/// A shape near the target (bumped, turned and moved: off its Procrustes placement) and two directions.
+struct ShapeNearTarget {
+  Eigen::VectorXd x, v, u;
+  explicit ShapeNearTarget(const TriMesh& target) {
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
+    x.resize(3 * target.vertex_count());
+    v.resizeLike(x);
+    u.resizeLike(x);
+    for (int i = 0; i < target.vertex_count(); ++i) {
+      const Eigen::Vector3d p = 1.05 * target.vertices.row(i).transpose() +
+                                Eigen::Vector3d(0.3 * std::sin(i), 0.2 * std::cos(3 * i), 0.0);
+      x.segment<3>(3 * i) = turn * p + Eigen::Vector3d(2.0, -1.0, 0.5);
+      v.segment<3>(3 * i) = Eigen::Vector3d(std::cos(i), std::sin(2 * i), 0.5);
+      u.segment<3>(3 * i) = Eigen::Vector3d(std::sin(5 * i), 0.3, std::cos(i));
+    }
+  }
+  /// A translation and an infinitesimal rotation of x.
+  std::vector<Eigen::VectorXd> rigid_motions() const {
+    Eigen::VectorXd translation(x.size()), rotation(x.size());
+    for (Eigen::Index i = 0; i < x.size() / 3; ++i) {
+      translation.segment<3>(3 * i) = Eigen::Vector3d(0.5, -1.0, 2.0);
+      rotation.segment<3>(3 * i) = Eigen::Vector3d(0.3, 1.0, -0.4).cross(Eigen::Vector3d(x.segment<3>(3 * i)));
+    }
+    return {translation, rotation};
+  }
+};
+
+TEST(DesignObjective, ItsSurfaceTermIsRigidInvariantWithAGradientThatMatchesCentralDifferences) {
   DesignOptions options;
   options.material = *parse_material_spec("silicone");
   ObjectiveScene scene(options);
-  const TriMesh& target = scene.target;
+  const ShapeNearTarget shape(scene.target);
+  Eigen::VectorXd gradient;
+  const double value = scene.objective.surface_term(shape.x, &gradient);
+  ASSERT_GT(value, 0.0);
+  // Moved rigidly, the shape keeps its placement on the target, so the term keeps its value.
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(1.1, Eigen::Vector3d(0, 1, 2).normalized()).toRotationMatrix();
+  Eigen::VectorXd moved = shape.x;
+  for (Eigen::Index i = 0; i < moved.size() / 3; ++i)
+    moved.segment<3>(3 * i) = turn * Eigen::Vector3d(shape.x.segment<3>(3 * i)) + Eigen::Vector3d(-4.0, 1.0, 3.0);
+  EXPECT_NEAR(scene.objective.surface_term(moved, nullptr), value, 1e-10 * value);
+  for (const Eigen::VectorXd& direction : {shape.v, shape.u}) {
+    const double h = 1e-6;
+    const double difference = (scene.objective.surface_term(shape.x + h * direction, nullptr) -
+                               scene.objective.surface_term(shape.x - h * direction, nullptr)) / (2.0 * h);
+    EXPECT_NEAR(gradient.dot(direction), difference, 1e-5 * gradient.norm() * direction.norm());
+  }
+}
+
+TEST(DesignObjective, ItsGaussNewtonOperatorIsSymmetricBlindToRigidMotionsAndAddsThePlacedSurfaceTerm) {
+  DesignOptions options;
+  options.material = *parse_material_spec("silicone");
+  ObjectiveScene scene(options);
   DesignObjective& objective = scene.objective;
   objective.grow_surface_weight(8);  // a weight other than the start's, so both terms count
+  const ShapeNearTarget shape(scene.target);
+  const ObjectiveGaussNewton hessian = objective.gauss_newton(shape.x);
 
-  Eigen::VectorXd x(3 * target.vertex_count()), v(3 * target.vertex_count());
-  for (int i = 0; i < target.vertex_count(); ++i) {
-    x.segment<3>(3 * i) = 1.05 * target.vertices.row(i).transpose() + Eigen::Vector3d(0.3 * std::sin(i), 0.2 * std::cos(3 * i), 0.0);
-    v.segment<3>(3 * i) = Eigen::Vector3d(std::cos(i), std::sin(2 * i), 0.5);
-  }
+  // Without the surface term it is E_dist's assembled Gauss-Newton matrix.
+  DesignOptions distance_only = options;
+  distance_only.k_surface = 0.0;
+  DesignObjective distance(scene.target, scene.start, distance_only, scene.model);
   std::vector<Eigen::Triplet<double>> entries;
-  objective.distance().hessian_triplets(x, entries, DistanceHessian::GaussNewton);
-  objective.add_surface_hessian(x, entries, 0);
-  Eigen::SparseMatrix<double> assembled(x.size(), x.size());
+  objective.distance().hessian_triplets(shape.x, entries, DistanceHessian::GaussNewton);
+  Eigen::SparseMatrix<double> assembled(shape.x.size(), shape.x.size());
   assembled.setFromTriplets(entries.begin(), entries.end());
-  const Eigen::VectorXd expected = assembled * v;
-  const Eigen::VectorXd product = objective.gauss_newton(x)(v);
-  ASSERT_GT(expected.norm(), 0.0);
-  EXPECT_LE((product - expected).norm(), 1e-12 * expected.norm());
+  const Eigen::VectorXd distance_part = assembled * shape.v;
+  ASSERT_GT(distance_part.norm(), 0.0);
+  EXPECT_LE((distance.gauss_newton(shape.x)(shape.v) - distance_part).norm(), 1e-12 * distance_part.norm());
+
+  // The surface part: symmetric, positive semi-definite, and nothing for a rigid motion.
+  const Eigen::VectorXd hv = hessian(shape.v), hu = hessian(shape.u);
+  EXPECT_NEAR(shape.u.dot(hv), shape.v.dot(hu), 1e-10 * hv.norm() * shape.u.norm());
+  EXPECT_GT(shape.v.dot(hv - distance_part), 0.0);
+  for (const Eigen::VectorXd& rigid : shape.rigid_motions())
+    EXPECT_LE(hessian(rigid).norm(), 1e-9 * hv.norm() * rigid.norm() / shape.v.norm());
 }
 
 }  // namespace
