@@ -15,14 +15,14 @@ ObjectiveGaussNewton::ObjectiveGaussNewton(Eigen::SparseMatrix<double, Eigen::Ro
 Eigen::VectorXd ObjectiveGaussNewton::operator()(const Eigen::VectorXd& v) const {
   const Eigen::VectorXd jv = m_distance_jacobian * v;
   Eigen::VectorXd out = 2.0 * (m_distance_jacobian.transpose() * jv);
-  if (m_surface_weight > 0.0) {
-    const Eigen::VectorXd placed_v = m_placement ? m_placement->push_forward(v) : v;
+  if (m_placement && m_surface_weight > 0.0) {
+    const Eigen::VectorXd placed_v = m_placement->push_forward(v);
     Eigen::VectorXd surface(v.size());
     for (Eigen::Index i = 0; i < m_surface_normals.rows(); ++i) {
       const Eigen::Vector3d n = m_surface_normals.row(i).transpose();
       surface.segment<3>(3 * i) = (2.0 * m_surface_weight * n.dot(placed_v.segment<3>(3 * i))) * n;
     }
-    out += m_placement ? m_placement->pull_back(surface) : surface;
+    out += m_placement->pull_back(surface);
   }
   return out;
 }

@@ -10,7 +10,6 @@
 #include <memory>
 
 #include "design/procrustes_placement.hpp"
-
 #include "mesh/tri_mesh.hpp"
 
 namespace balloon {
@@ -19,7 +18,7 @@ class ObjectiveGaussNewton {
  public:
   /// `distance_jacobian`: dr/dx of E_dist's residuals (E_dist = |r|^2); `surface_normals`: #V unit normals
   /// (a zero row leaves that vertex out); `surface_weight`: w of E_surf = w sum_i d_i^2 (mm^-1).
-  /// `placement`: P(x), in whose frame the normals are.
+  /// `placement`: P(x), in whose frame the normals are (null: no surface term).
   ObjectiveGaussNewton(Eigen::SparseMatrix<double, Eigen::RowMajor> distance_jacobian, Positions surface_normals,
                        double surface_weight, std::shared_ptr<const ProcrustesPlacement> placement);
 

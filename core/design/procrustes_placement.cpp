@@ -1,6 +1,7 @@
 #include "design/procrustes_placement.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <cmath>
 
 namespace balloon {
 

@@ -14,9 +14,9 @@
 #include "design/distance_energy.hpp"
 #include "design/lbfgs.hpp"
 #include "design/reduced_gauss_newton.hpp"
-#include "solve/rigid_modes.hpp"
 #include "design/surface_distance.hpp"
 #include "solve/equilibrium_solver.hpp"
+#include "solve/rigid_modes.hpp"
 
 namespace balloon {
 
