@@ -150,7 +150,7 @@ class ReducedSpaceDesign {
       // Every term is blind to rigid motions of the rest shape, so a direction's rigid part (what the
       // Gauss-Newton model's null space and its preconditioner leave in) gains nothing, but spends the trust
       // radius and turns the balloon about its pinned coordinates: latex cactus's trials crept from the
-      // first iteration on and it stalled at the baseline; without it, 3.1x. A nozzle pins the rest shape.
+      // first iteration on and it stalled at the baseline; without it, 4.9-7.6x. A nozzle pins the rest shape.
       if (m_all_rest_free) direction = without_rigid_motion(rest, direction);
       // Trust region on the rest shape: no vertex moves more than `radius` (at most 2% of the target's
       // size) per step. The radius shrinks to the last step that needed halving and grows back after
@@ -239,11 +239,10 @@ class ReducedSpaceDesign {
       // is taken at that placement (rigid-invariant, as E_dist is), so no term changes; when it was taken
       // at the pinned placement, E_surf fought E_dist for it (a matchable target stalled at 4e-4 of its
       // size), and each re-placement undid what the step had gained (latex blobby: 2-9% of the objective).
-      const bool realigned = m_objective.realign(m_x);
+      m_objective.realign(m_x);
       Eigen::VectorXd new_gradient;
-      // The line search already evaluated this point; only a changed set of colliding pairs or a
-      // re-placement alters it.
-      objective = collisions_changed || realigned ? m_objective.value(rest, m_x) : trial_objective;
+      // The line search already evaluated this point; only a changed set of colliding pairs alters it.
+      objective = collisions_changed ? m_objective.value(rest, m_x) : trial_objective;
       if (!objective_gradient(rest, new_gradient)) {
         stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized");
         break;
