@@ -11,6 +11,7 @@
 //                     [--material silicone|latex|SPEC]... [--resolution N=3000 (4000 with --corpus)]
 //                     [--max-time S=60] [--volume-ratio R=8] [--method adjoint|alm (default: both)]
 //                     [--coarse-vertices N] [--surface-growth F (DesignOptions::surface_growth; 1: off)]
+//                     [--surface-growth-iterations N] [--k-surface K (DesignOptions::k_surface; 0: off)]
 //                     [--quick]   (--quick: bunny only, 1000 vertices, 20 s per design)
 #include <algorithm>
 #include <cstdio>
@@ -109,6 +110,8 @@ int main(int argc, char** argv) {
   double volume_ratio = 8.0;
   int coarse_vertices = balloon::DesignOptions{}.coarse_vertices;  // 0: full resolution only
   double surface_growth = balloon::DesignOptions{}.surface_growth;  // 1: the surface term's weight stays
+  int surface_growth_iterations = balloon::DesignOptions{}.surface_growth_iterations;
+  double k_surface = balloon::DesignOptions{}.k_surface;  // 0: no surface term
   std::vector<std::string> mesh_filters, material_specs;
   std::vector<balloon::DesignMethod> methods = {balloon::DesignMethod::Adjoint,
                                                 balloon::DesignMethod::AugmentedLagrangian};
@@ -139,6 +142,10 @@ int main(int argc, char** argv) {
       coarse_vertices = std::atoi(argv[++i]);
     } else if (arg == "--surface-growth" && i + 1 < argc) {
       surface_growth = std::atof(argv[++i]);
+    } else if (arg == "--surface-growth-iterations" && i + 1 < argc) {
+      surface_growth_iterations = std::atoi(argv[++i]);
+    } else if (arg == "--k-surface" && i + 1 < argc) {
+      k_surface = std::atof(argv[++i]);
     } else if (arg == "--volume-ratio" && i + 1 < argc) {
       volume_ratio = std::atof(argv[++i]);
     } else if (!arg.empty() && arg[0] != '-') {
@@ -147,7 +154,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr,
                    "usage: bench_design [OUT_DIR] [--data DIR] [--corpus] [--mesh SUBSTRING]... [--material SPEC]... "
                    "[--resolution N] [--max-time S] [--volume-ratio R] [--method adjoint|alm] [--coarse-vertices N] [--surface-growth F] "
-                   "[--quick]\n");
+                   "[--surface-growth-iterations N] [--k-surface K] [--quick]\n");
       return 2;
     }
   }
@@ -227,6 +234,8 @@ int main(int argc, char** argv) {
         options.max_time_s = max_time_s;
         options.coarse_vertices = coarse_vertices;
         options.surface_growth = surface_growth;
+        options.surface_growth_iterations = surface_growth_iterations;
+        options.k_surface = k_surface;
         balloon::bench::reset_peak_memory();
         runs.push_back({shape.name, material_label, balloon::design_balloon(target->mesh, options)});
         const double peak_mb = balloon::bench::peak_memory_mb();
