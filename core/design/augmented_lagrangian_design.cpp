@@ -157,6 +157,7 @@ class AugmentedLagrangianDesign {
       }
       if (result.stop != DesignStop::IterationLimit) break;
       m_objective.update_max_volume_term(z.head(n), start_distance, result);
+      m_objective.note_rest_barriers(z.head(n), result);
       const Eigen::VectorXd c = constraints(z);
       const double new_norm = c.norm();
       if (new_norm <= 0.25 * constraint_norm || new_norm <= 1e-6 * force_scale) {

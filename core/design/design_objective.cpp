@@ -14,6 +14,11 @@ constexpr double COPLANAR_HINGE_RAD = 1e-3;
 /// Rest-bending stiffness relative to E_dist's k_bending: enough to fix the null space of flat regions,
 /// small enough not to pull the design away from the target.
 constexpr double REST_BENDING_WEIGHT = 1e-2;
+/// The rest mesh's barriers (rest_triangle_quality, rest_hinge_fold): a surface whose every triangle or
+/// hinge is one unit past its threshold costs this times E_dist's total reference edge length (mm), about
+/// 4 times E_dist at a typical start. One sliver 100 times flatter than its start triangle then costs
+/// about E_dist at the start; changes up to the thresholds cost nothing.
+constexpr double REST_QUALITY_WEIGHT = 1.0;
 /// A stalled design whose inflated shape is further than this (relative to the diagonal, on average)
 /// from its rigid placement on the target is re-placed and continues.
 constexpr double REALIGN_TOLERANCE_REL = 1e-4;
@@ -35,6 +40,8 @@ DesignObjective::DesignObjective(const TriMesh& target, const TriMesh& start, co
       m_distance(target.vertices, target.faces, options.k_length, options.k_bending),
       m_surface(target),
       m_start_hinges(start.vertices, target.faces, 0.0, REST_BENDING_WEIGHT * options.k_bending),
+      m_rest_quality(start.vertices, target.faces, REST_QUALITY_WEIGHT * m_distance.rest_lengths().sum()),
+      m_rest_fold(m_start_hinges, REST_QUALITY_WEIGHT * m_distance.rest_lengths().sum()),
       m_start_volume(enclosed_volume(start.vertices, target.faces)) {
   // Rest-shape collisions: vertices closer than half a mean edge (eq. 24), costing one kd-tree pass
   // per accepted iteration and nothing else while no pair is near.
@@ -99,6 +106,7 @@ double DesignObjective::regularizer_value(const Eigen::VectorXd& rest) const {
   if (m_collision->any_active()) value += m_collision->value(rest);
   if (m_rest_bending_active) value += m_start_hinges.value(rest);
   if (m_max_volume_weight > 0.0) value -= m_max_volume_weight * enclosed_volume(unflatten(rest), m_target.faces);
+  value += m_rest_quality.value(rest) + m_rest_fold.value(rest);
   return value;
 }
 
@@ -113,6 +121,24 @@ void DesignObjective::add_regularizer_gradient(const Eigen::VectorXd& rest, Eige
     gradient += part;
   }
   if (m_max_volume_weight > 0.0) gradient -= m_max_volume_weight * m_model.volume_gradient(rest);
+  m_rest_quality.add_gradient(rest, gradient);
+  m_rest_fold.add_gradient(rest, gradient);
+}
+
+Eigen::VectorXd DesignObjective::regularizer_gauss_newton_times(const Eigen::VectorXd& rest,
+                                                                const Eigen::VectorXd& direction) const {
+  return m_rest_quality.gauss_newton_times(rest, direction) + m_rest_fold.gauss_newton_times(rest, direction);
+}
+
+void DesignObjective::note_rest_barriers(const Eigen::VectorXd& rest, DesignResult& result) {
+  if (!m_rest_quality_seen && m_rest_quality.distorted_count(rest) > 0) {
+    m_rest_quality_seen = true;
+    result.active_terms.push_back("rest_quality");
+  }
+  if (!m_rest_fold_seen && m_rest_fold.folded_count(rest) > 0) {
+    m_rest_fold_seen = true;
+    result.active_terms.push_back("rest_fold");
+  }
 }
 
 Positions DesignObjective::closest_target_normals(const Positions& points) const {

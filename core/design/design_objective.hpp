@@ -1,8 +1,9 @@
 #pragma once
 /// The design objective and its terms (paper sec. 5): E_dist(x) (eq. 18) against the target, the surface
 /// term E_surf(x) (the error the result reports), and the rest-shape regularizers R(rest) that join only
-/// when the scene needs them: rest collisions (eq. 24), rest bending against the start (flat starts), and
-/// the maximum-volume term (alm, once a rest region has turned inside out). Both optimizers minimise
+/// when the scene needs them: rest collisions (eq. 24), rest bending against the start (flat starts), the
+/// maximum-volume term (alm, once a rest region has turned inside out), and two barriers on the rest mesh
+/// (once a triangle's shape or a hinge's angle has changed past its threshold). Both optimizers minimise
 /// value(rest, x) with x the inflated shape of rest; they differ in how they keep x an equilibrium.
 /// Positions are flat 3#V vectors (mm).
 #include <Eigen/Core>
@@ -14,6 +15,8 @@
 #include "design/distance_energy.hpp"
 #include "design/objective_gauss_newton.hpp"
 #include "design/procrustes_placement.hpp"
+#include "design/rest_hinge_fold.hpp"
+#include "design/rest_triangle_quality.hpp"
 #include "design/self_collision.hpp"
 #include "design/surface_distance.hpp"
 #include "fem/balloon_model.hpp"
@@ -39,6 +42,9 @@ class DesignObjective {
   double regularizer_value(const Eigen::VectorXd& rest) const;
   /// Adds the gradient of regularizer_value to `gradient`.
   void add_regularizer_gradient(const Eigen::VectorXd& rest, Eigen::Ref<Eigen::VectorXd> gradient) const;
+  /// The Gauss-Newton Hessian of the rest mesh's barriers times `direction` (3#V; zero while no triangle
+  /// or hinge is past its threshold). The other regularizers are left out of the Gauss-Newton model.
+  Eigen::VectorXd regularizer_gauss_newton_times(const Eigen::VectorXd& rest, const Eigen::VectorXd& direction) const;
 
   /// Sets E_surf's weight to k_surface times its growth after `iterations` iterations (see
   /// DesignOptions::surface_growth); true when that changed it, i.e. value() and its gradient changed.
@@ -57,6 +63,10 @@ class DesignObjective {
   /// `result` the first time any is near. True when the collision term was or is on, i.e. value() at
   /// rest may differ from before the update.
   bool update_collisions(const Eigen::VectorXd& rest, DesignResult& result);
+
+  /// Lists "rest_quality" in `result` the first time a rest triangle is past its barrier's threshold, and
+  /// "rest_fold" the first time a rest hinge is.
+  void note_rest_barriers(const Eigen::VectorXd& rest, DesignResult& result);
 
   /// Once a rest region has turned inside out, the maximum-volume term (paper sec. 5.2) joins the
   /// objective, weighted so that a 1% volume change is worth 1% of the start's E_dist.
@@ -90,6 +100,9 @@ class DesignObjective {
   SurfaceDistance m_surface;
   DistanceEnergy m_start_hinges;  ///< the start's hinge angles; with k_length 0 it is the rest-bending term
   std::unique_ptr<SelfCollision> m_collision;
+  RestTriangleQuality m_rest_quality;
+  RestHingeFold m_rest_fold;
+  bool m_rest_quality_seen = false, m_rest_fold_seen = false;
   bool m_collision_seen = false;
   bool m_rest_bending_active = false;
   double m_unit_surface_weight = 0.0;  ///< w of E_surf = w sum_i d_i^2 for k_surface = 1 (mm^-1)

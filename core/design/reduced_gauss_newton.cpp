@@ -7,7 +7,8 @@ namespace balloon {
 GaussNewtonDirection reduced_gauss_newton_direction(
     const AdjointSensitivity& sensitivity, const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& hessian_x,
     const Eigen::VectorXd& gradient, const std::vector<bool>& rest_free, const Eigen::VectorXd& rest_volume_gradient,
-    const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& precondition, int max_iterations, double tolerance) {
+    const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& precondition, int max_iterations, double tolerance,
+    const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& hessian_rest) {
   Eigen::VectorXd w = rest_volume_gradient;
   for (int c = 0; c < w.size(); ++c)
     if (!rest_free[static_cast<size_t>(c)]) w[c] = 0.0;
@@ -22,7 +23,9 @@ GaussNewtonDirection reduced_gauss_newton_direction(
     Eigen::VectorXd dx;
     double dp = 0.0;
     sensitivity.linear_response(d, dx, dp);  // J d
-    return project(sensitivity.gradient(hessian_x(dx)));  // P J^T H J d
+    Eigen::VectorXd product = sensitivity.gradient(hessian_x(dx));  // J^T H J d
+    if (hessian_rest) product += hessian_rest(d);
+    return project(product);
   };
 
   GaussNewtonDirection out;

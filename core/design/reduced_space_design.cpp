@@ -235,6 +235,7 @@ class ReducedSpaceDesign {
       m_x = trial_x;
       m_pressure = trial_pressure;
       const bool collisions_changed = m_objective.update_collisions(rest, result);
+      m_objective.note_rest_barriers(rest, result);
       // Re-placed on the target after every step (vertex correspondence, the result's placement). E_surf
       // is taken at that placement (rigid-invariant, as E_dist is), so no term changes; when it was taken
       // at the pinned placement, E_surf fought E_dist for it (a matchable target stalled at 4e-4 of its
@@ -347,7 +348,8 @@ class ReducedSpaceDesign {
     return reduced_gauss_newton_direction(
         m_sensitivity, hessian, gradient, m_rest_free, m_model.volume_gradient(rest),
         [this](const Eigen::VectorXd& q) { return m_lbfgs.precondition(q); }, GAUSS_NEWTON_CG_ITERATIONS,
-        GAUSS_NEWTON_CG_TOLERANCE);
+        GAUSS_NEWTON_CG_TOLERANCE,
+        [this, &rest](const Eigen::VectorXd& d) { return m_objective.regularizer_gauss_newton_times(rest, d); });
   }
 
   /// L-BFGS's initial inverse Hessian: the Gauss-Newton Hessian of E_dist at the start's inflation,
