@@ -153,7 +153,7 @@ class ReducedSpaceDesign {
       // first iteration on and it stalled at the baseline; without it, 4.9-7.6x. A nozzle pins the rest shape.
       if (m_all_rest_free) direction = without_rigid_motion(rest, direction);
       // Trust region on the rest shape: no vertex moves more than `radius` (at most 2% of the target's
-      // size) per step. The radius shrinks to the last step that needed halving and grows back after
+      // size) per step. The radius shrinks by as much as the last step needed halving and grows back after
       // full steps, so a wrinkling region costs one failed equilibrium, not one per iteration.
       const double largest = unflatten(direction).rowwise().norm().maxCoeff();
       double t = largest > radius ? radius / largest : 1.0;
@@ -229,7 +229,10 @@ class ReducedSpaceDesign {
         }
         break;
       }
-      radius = t < first_t ? t * largest : std::min(max_radius, 2.0 * radius);
+      // Cut k times, the radius shrinks by 2^k; it is not set to the step taken: a short direction's step
+      // (a barrier's, 1e-6 mm) that needed one halving had set it there, and the next full-size direction
+      // started at t = 2e-6 and spent the rest of the budget doubling it back (latex teddy, stalled).
+      radius = t < first_t ? radius * (t / first_t) : std::min(max_radius, 2.0 * radius);
       const Eigen::VectorXd step = trial_rest - rest;
       rest = trial_rest;
       m_x = trial_x;

@@ -45,8 +45,13 @@ bool should_stop(const NewtonSettings& settings, NewtonReport& report) {
 }
 
 std::string converged_message(const NewtonReport& report) {
-  if (report.rounding_floor <= 0.0) return "converged";
   char text[160];
+  if (report.stagnated_at > 0.0) {
+    std::snprintf(text, sizeof(text), "converged to %.3g N, %.2gx the force tolerance, where Newton stagnated",
+                  report.residual_norm, report.stagnated_at);
+    return text;
+  }
+  if (report.rounding_floor <= 0.0) return "converged";
   std::snprintf(text, sizeof(text), "converged at the residual's rounding floor (%.3g N, at most %.3g N)",
                 report.residual_norm, report.rounding_floor);
   return text;
@@ -298,6 +303,14 @@ NewtonReport EquilibriumSolver::newton_volume(Eigen::VectorXd& x, double& pressu
       scaled_residuals.push_back(report.residual_norm / force_tolerance);
       const size_t last = scaled_residuals.size() - 1;
       if (last >= 4 && scaled_residuals[last] > 0.5 * scaled_residuals[last - 2]) {
+        if (scaled_residuals[last] <= settings.stagnation_tolerance_factor && std::abs(c) <= volume_tolerance) {
+          report.unstable_modes = m_last_unstable_modes;
+          report.converged = true;
+          report.stop = NewtonStop::Converged;
+          report.stagnated_at = scaled_residuals[last];
+          report.message = converged_message(report);
+          return report;
+        }
         report.stop = NewtonStop::Slow;
         report.message = "converging too slowly";
         return report;
