@@ -69,7 +69,6 @@ TEST(RestHingeFold, GradientMatchesCentralDifferences) {
       test::central_difference_gradient([&](const Eigen::VectorXd& y) { return fold.value(y); }, rest, 1e-6);
   ASSERT_GT(expected.norm(), 1e-3);
   EXPECT_LT((gradient - expected).norm(), 1e-6 * expected.norm());
-
 }
 
 TEST(RestHingeFold, GaussNewtonProductIsTwiceTheWeightTimesTheSquaredRate) {
