@@ -13,25 +13,29 @@ RestHingeFold::RestHingeFold(const DistanceEnergy& start, double weight)
   m_weights *= weight / std::max(total, std::numeric_limits<double>::min());
 }
 
-double RestHingeFold::turn(const Eigen::VectorXd& rest, int hinge) const {
-  const auto corner = [&](int k) { return Eigen::Vector3d(rest.segment<3>(3 * m_hinges(hinge, k))); };
-  const double angle = dihedral_angle(corner(0), corner(1), corner(2), corner(3));
-  return std::abs(std::remainder(angle - m_start_angles[hinge], 2.0 * M_PI));
+Eigen::Vector3d RestHingeFold::corner(const Eigen::VectorXd& rest, int hinge, int k) const {
+  return rest.segment<3>(3 * m_hinges(hinge, k));
 }
 
+double RestHingeFold::signed_turn(const Eigen::VectorXd& rest, int hinge) const {
+  const double angle = dihedral_angle(corner(rest, hinge, 0), corner(rest, hinge, 1), corner(rest, hinge, 2),
+                                      corner(rest, hinge, 3));
+  return std::remainder(angle - m_start_angles[hinge], 2.0 * M_PI);
+}
+
+double RestHingeFold::turn(const Eigen::VectorXd& rest, int hinge) const { return std::abs(signed_turn(rest, hinge)); }
+
 double RestHingeFold::ratio_and_gradient(const Eigen::VectorXd& rest, int hinge, Vector12d* gradient) const {
-  const auto corner = [&](int k) { return Eigen::Vector3d(rest.segment<3>(3 * m_hinges(hinge, k))); };
-  const double signed_turn = std::remainder(dihedral_angle(corner(0), corner(1), corner(2), corner(3)) -
-                                                m_start_angles[hinge],
-                                            2.0 * M_PI);
-  const double d = std::abs(signed_turn);
+  const double turned = signed_turn(rest, hinge);
+  const double d = std::abs(turned);
   if (!(d > THRESHOLD)) return 0.0;
   if (!(d < M_PI)) return std::numeric_limits<double>::infinity();
   const double ratio = (d - THRESHOLD) / (M_PI - d);
   if (gradient) {
     // dr/dd = (pi - THRESHOLD) / (pi - d)^2, and dd/dtheta = sign of the turn.
-    const double slope = (M_PI - THRESHOLD) / ((M_PI - d) * (M_PI - d)) * (signed_turn < 0.0 ? -1.0 : 1.0);
-    *gradient = slope * dihedral_angle_gradient(corner(0), corner(1), corner(2), corner(3));
+    const double slope = (M_PI - THRESHOLD) / ((M_PI - d) * (M_PI - d)) * (turned < 0.0 ? -1.0 : 1.0);
+    *gradient = slope * dihedral_angle_gradient(corner(rest, hinge, 0), corner(rest, hinge, 1),
+                                                corner(rest, hinge, 2), corner(rest, hinge, 3));
   }
   return ratio;
 }
@@ -49,7 +53,7 @@ void RestHingeFold::add_gradient(const Eigen::VectorXd& rest, Eigen::Ref<Eigen::
   Vector12d ratio_gradient;
   for (int h = 0; h < m_hinges.rows(); ++h) {
     const double ratio = ratio_and_gradient(rest, h, &ratio_gradient);
-    if (!(ratio > 0.0)) continue;
+    if (!(ratio > 0.0) || !std::isfinite(ratio)) continue;  // at a full fold the value is infinite already
     for (int k = 0; k < 4; ++k)
       gradient.segment<3>(3 * m_hinges(h, k)) += 2.0 * m_weights[h] * ratio * ratio_gradient.segment<3>(3 * k);
   }

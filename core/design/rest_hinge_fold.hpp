@@ -42,6 +42,10 @@ class RestHingeFold {
  private:
   /// r of `hinge` (0 below the threshold) and, when asked and r > 0, dr/d(its four corners).
   double ratio_and_gradient(const Eigen::VectorXd& rest, int hinge, Vector12d* gradient) const;
+  /// theta_rest - theta_start of `hinge`, modulo 2 pi in [-pi, pi] (rad).
+  double signed_turn(const Eigen::VectorXd& rest, int hinge) const;
+  /// Corner k (0-3) of `hinge` at rest (mm).
+  Eigen::Vector3d corner(const Eigen::VectorXd& rest, int hinge, int k) const;
 
   Eigen::Matrix<int, Eigen::Dynamic, 4, Eigen::RowMajor> m_hinges;  ///< per hinge: v0, v1, v2, v3
   Eigen::VectorXd m_start_angles;  ///< rad

@@ -67,7 +67,7 @@ void RestTriangleQuality::add_gradient(const Eigen::VectorXd& rest, Eigen::Ref<E
   Eigen::Matrix<double, 9, 1> corner_gradient;
   for (int f : m_used_faces) {
     const double excess = distortion_and_gradient(rest, f, &corner_gradient) - THRESHOLD;
-    if (!(excess > 0.0)) continue;
+    if (!(excess > 0.0) || !std::isfinite(excess)) continue;  // a flat triangle's value is infinite already
     for (int k = 0; k < 3; ++k)
       gradient.segment<3>(3 * m_faces(f, k)) += 2.0 * m_face_weight[f] * excess * corner_gradient.segment<3>(3 * k);
   }
@@ -79,7 +79,7 @@ Eigen::VectorXd RestTriangleQuality::gauss_newton_times(const Eigen::VectorXd& r
   Eigen::Matrix<double, 9, 1> corner_gradient;
   for (int f : m_used_faces) {
     const double excess = distortion_and_gradient(rest, f, &corner_gradient) - THRESHOLD;
-    if (!(excess > 0.0)) continue;
+    if (!(excess > 0.0) || !std::isfinite(excess)) continue;  // a flat triangle's value is infinite already
     double along = 0.0;
     for (int k = 0; k < 3; ++k) along += corner_gradient.segment<3>(3 * k).dot(direction.segment<3>(3 * m_faces(f, k)));
     for (int k = 0; k < 3; ++k)
