@@ -3,17 +3,20 @@
 #include <cmath>
 #include <limits>
 
+#include "fem/membrane_element.hpp"
+
 namespace balloon {
 
 RestTriangleQuality::RestTriangleQuality(const Positions& start, const Faces& faces, double weight)
     : m_faces(faces), m_inverse_metric(faces.rows(), 3), m_start_area(faces.rows()), m_face_weight(faces.rows()) {
   double total_area = 0.0;
   for (int f = 0; f < faces.rows(); ++f) {
-    const Eigen::Vector3d a = start.row(faces(f, 0)), b = start.row(faces(f, 1)), c = start.row(faces(f, 2));
-    const Eigen::Vector3d e1 = b - a, e2 = c - a;
-    const double g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2);
+    fem::Vector9d corners;
+    for (int k = 0; k < 3; ++k) corners.segment<3>(3 * k) = start.row(faces(f, k)).transpose();
+    const fem::RestTriangle metric = fem::make_rest_triangle(corners);  // G_start and the area
+    const double g11 = metric.m11, g12 = metric.m12, g22 = metric.m22;
     const double determinant = g11 * g22 - g12 * g12;  // (2 A)^2
-    m_start_area[f] = 0.5 * std::sqrt(std::max(0.0, determinant));
+    m_start_area[f] = metric.area;
     m_inverse_metric.row(f) << g22 / determinant, -g12 / determinant, g11 / determinant;
     // A start triangle with no area has no shape to keep.
     if (determinant > 1e-12 * (g11 + g22) * (g11 + g22) && m_inverse_metric.row(f).allFinite()) {
