@@ -43,6 +43,11 @@ class AdjointSensitivity {
   Eigen::VectorXd mixed_product(const Eigen::VectorXd& rest, const Eigen::VectorXd& x, const Eigen::VectorXd& s,
                                 bool transpose) const;
 
+  /// dV/dp (mm^3/MPa) along the pressure-volume curve of the prepared rest shape at its equilibrium:
+  /// v^T K^-1 v. Positive on the rising branch, negative past a pressure maximum (where the balloon would
+  /// snap under pressure control and only the volume holds it).
+  double volume_per_pressure() const { return m_volume_gradient.dot(m_volume_response); }
+
   /// v = dV/dx and K^-1 v at the prepared equilibrium.
   const Eigen::VectorXd& volume_gradient() const { return m_volume_gradient; }
   const Eigen::VectorXd& volume_response() const { return m_volume_response; }

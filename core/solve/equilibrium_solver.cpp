@@ -299,7 +299,7 @@ NewtonReport EquilibriumSolver::newton_volume(Eigen::VectorXd& x, double& pressu
     }
     if (settings.on_iteration) settings.on_iteration(report.iterations, report.residual_norm, pressure_mpa);
     if (should_stop(settings, report)) return report;
-    if (settings.abandon_slow) {
+    if (settings.abandon_slow || settings.stagnation_tolerance_factor > 0.0) {
       scaled_residuals.push_back(report.residual_norm / force_tolerance);
       const size_t last = scaled_residuals.size() - 1;
       if (last >= 4 && scaled_residuals[last] > 0.5 * scaled_residuals[last - 2]) {
@@ -311,9 +311,11 @@ NewtonReport EquilibriumSolver::newton_volume(Eigen::VectorXd& x, double& pressu
           report.message = converged_message(report);
           return report;
         }
-        report.stop = NewtonStop::Slow;
-        report.message = "converging too slowly";
-        return report;
+        if (settings.abandon_slow) {
+          report.stop = NewtonStop::Slow;
+          report.message = "converging too slowly";
+          return report;
+        }
       }
     }
     const Eigen::VectorXd v = m_assembly.restrict(m_model.volume_gradient(x));

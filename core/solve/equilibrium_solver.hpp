@@ -94,8 +94,9 @@ struct NewtonSettings {
   /// design's trials start a first-order step from their solution, so a trial that converges this slowly
   /// has stepped into a wrinkling or snapping region, and a shorter step costs less than finishing it.
   bool abandon_slow = false;
-  /// Volume control, with abandon_slow: a solve that stagnates there with the volume met and |r| at most
-  /// this many force tolerances counts as converged, reported as NewtonReport::stagnated_at (0 = never).
+  /// Volume control: a solve that stagnates (abandon_slow's test, whether or not it abandons) with the
+  /// volume met and |r| at most this many force tolerances counts as converged, reported as
+  /// NewtonReport::stagnated_at (0 = never).
   /// Near a wrinkling bifurcation the stiffness is nearly singular, and exact steps wander a little above
   /// the tolerance without converging (the design's latex knot: 13 exact steps between 1e-5 and 9e-5 N
   /// against 9.5e-6 N, the volume met to 1e-4 mm^3; nothing non-smooth in that model).

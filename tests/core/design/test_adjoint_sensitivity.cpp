@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "material/homogeneous_tests.hpp"
 #include "sensitivity_scene.hpp"
 
 namespace balloon {
@@ -56,6 +57,51 @@ TEST_P(AdjointSensitivityTest, LinearResponseMatchesCentralDifferences) {
   const Eigen::VectorXd dx_fd = (x_plus - x_minus) / (2.0 * STEP_MM);
   EXPECT_LT((dx - dx_fd).norm(), 1e-5 * dx_fd.norm()) << "|dx| " << dx.norm() << ", |dx_fd| " << dx_fd.norm();
   EXPECT_NEAR(dp, (p_plus - p_minus) / (2.0 * STEP_MM), 1e-5 * std::abs(dp) + 1e-12);
+}
+
+/// dV/dp at the volume-controlled equilibrium of a sphere of radius R (geodesic, 642 vertices) inflated
+/// to volume ratio `ratio` with `material_spec`, 0.5 mm thick, and the closed form's
+/// 4 pi R^3 l^2 / (dp/dl) at l = ratio^(1/3) (central differences of the sphere law).
+void sphere_volume_per_pressure(const char* material_spec, double ratio, double& computed, double& closed_form) {
+  constexpr double RADIUS_MM = 20.0, THICKNESS_MM = 0.5;
+  const TriMesh sphere = make_icosphere(RADIUS_MM, 3);
+  const Material material = *parse_material_spec(material_spec);
+  fem::BalloonModel model(sphere, material, std::vector<double>(static_cast<size_t>(sphere.face_count()), THICKNESS_MM));
+  EquilibriumSolver solver(model, Scene::support(sphere));
+  InflationOptions inflation;
+  inflation.material = material;
+  inflation.thickness_mm = THICKNESS_MM;
+  inflation.bending = BendingUse::Off;
+  inflation.volume_ratio = ratio;
+  const InflationResult inflated = inflate(sphere, inflation);
+  ASSERT_TRUE(inflated.converged) << inflated.message;
+  Eigen::VectorXd x = flat(inflated.deformed);
+  double pressure = 1e-3 * inflated.pressure_kpa;
+  NewtonSettings tight;
+  tight.relative_tolerance = 1e-10;
+  tight.max_iterations = 50;
+  ASSERT_TRUE(solver.solve_volume(x, pressure, enclosed_volume(inflated.deformed, sphere.faces), tight).converged);
+  AdjointSensitivity sensitivity(model, solver);
+  ASSERT_TRUE(sensitivity.prepare(flat(sphere.vertices), x, pressure));
+  computed = sensitivity.volume_per_pressure();
+  const double stretch = std::cbrt(ratio), h = 1e-5;
+  const double slope = (sphere_pressure(material, RADIUS_MM, THICKNESS_MM, stretch + h) -
+                        sphere_pressure(material, RADIUS_MM, THICKNESS_MM, stretch - h)) / (2.0 * h);
+  closed_form = 4.0 * M_PI * std::pow(RADIUS_MM, 3) * stretch * stretch / slope;
+}
+
+TEST(VolumePerPressure, MatchesTheSphereLawOnTheRisingBranch) {
+  double computed = 0.0, closed_form = 0.0;
+  sphere_volume_per_pressure("silicone", 8.0, computed, closed_form);
+  ASSERT_GT(closed_form, 0.0) << "silicone's sphere law rises again at x8";
+  EXPECT_NEAR(computed / closed_form, 1.0, 0.02);  // the 642-vertex polyhedron: 1.2% off
+}
+
+TEST(VolumePerPressure, IsNegativePastThePressureMaximum) {
+  double computed = 0.0, closed_form = 0.0;
+  sphere_volume_per_pressure("latex", 8.0, computed, closed_form);
+  ASSERT_LT(closed_form, 0.0) << "latex's sphere law falls at x8";
+  EXPECT_NEAR(computed / closed_form, 1.0, 0.02);
 }
 
 INSTANTIATE_TEST_SUITE_P(MembraneAndBending, AdjointSensitivityTest, ::testing::Bool(),

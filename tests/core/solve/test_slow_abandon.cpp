@@ -54,13 +54,16 @@ TEST(SlowAbandon, ACreepingSolveFarAboveTheToleranceIsNotTakenForStagnation) {
 
 /// The ellipsoid at its rest volume with Pipkin's tension field: zero pressure, every triangle at the
 /// relaxed energy's kink between slack and taut, where Newton stagnates far above a 1e-10 tolerance.
-NewtonReport solve_at_the_slack_boundary(double stagnation_factor, double* volume_error = nullptr) {
+constexpr int SLACK_BOUNDARY_ITERATIONS = 60;
+
+NewtonReport solve_at_the_slack_boundary(double stagnation_factor, double* volume_error = nullptr,
+                                         bool abandon_slow = true) {
   test::EllipsoidSolve ellipsoid;
   ellipsoid.model.set_tension_field(true);
   NewtonSettings settings;
   settings.relative_tolerance = 1e-10;
-  settings.max_iterations = 60;
-  settings.abandon_slow = true;
+  settings.max_iterations = SLACK_BOUNDARY_ITERATIONS;
+  settings.abandon_slow = abandon_slow;
   settings.stagnation_tolerance_factor = stagnation_factor;
   Eigen::VectorXd x = flat(ellipsoid.mesh.vertices);
   double pressure = 0.0;
@@ -88,6 +91,24 @@ TEST(SlowAbandon, AStagnationWithinTheFactorIsConvergedAndSaysHowFarAboveTheTole
   EXPECT_FALSE(beyond.converged);
   EXPECT_EQ(beyond.stop, NewtonStop::Slow);
   EXPECT_EQ(beyond.stagnated_at, 0.0);
+}
+
+// The design's trials on the rising branch are never abandoned but still accept a stagnation within the
+// factor; beyond it they run on to their iteration limit.
+TEST(SlowAbandon, WithoutAbandoningAStagnationWithinTheFactorIsStillConverged) {
+  const NewtonReport unbounded = solve_at_the_slack_boundary(1e12, nullptr, false);
+  ASSERT_TRUE(unbounded.converged) << unbounded.message;
+  const double stagnated_at = unbounded.stagnated_at;
+  ASSERT_GT(stagnated_at, 1.0) << "the case no longer stagnates: " << unbounded.message;
+
+  const NewtonReport within = solve_at_the_slack_boundary(2.0 * stagnated_at, nullptr, false);
+  EXPECT_TRUE(within.converged);
+  EXPECT_NEAR(within.stagnated_at, stagnated_at, 1e-9 * stagnated_at);
+
+  const NewtonReport beyond = solve_at_the_slack_boundary(0.5 * stagnated_at, nullptr, false);
+  EXPECT_FALSE(beyond.converged);
+  EXPECT_NE(beyond.stop, NewtonStop::Slow);
+  EXPECT_EQ(beyond.iterations, SLACK_BOUNDARY_ITERATIONS);
 }
 
 }  // namespace
