@@ -2,7 +2,6 @@
 
 #include <cmath>
 
-
 namespace balloon {
 
 AdjointSensitivity::AdjointSensitivity(const fem::BalloonModel& model, EquilibriumSolver& solver)
@@ -13,7 +12,7 @@ bool AdjointSensitivity::prepare(const Eigen::VectorXd& rest, const Eigen::Vecto
   m_volume_gradient = m_model.volume_gradient(x);
   m_volume_response = m_solver.solve_with_factorization(m_volume_gradient);
   m_mixed = mixed_blocks(rest, x);
-  return std::abs(m_volume_gradient.dot(m_volume_response)) > 0.0 && m_volume_response.allFinite();
+  return std::abs(volume_per_pressure()) > 0.0 && m_volume_response.allFinite();
 }
 
 Eigen::VectorXd AdjointSensitivity::gradient(const Eigen::VectorXd& objective_gradient_x) const {
@@ -21,7 +20,7 @@ Eigen::VectorXd AdjointSensitivity::gradient(const Eigen::VectorXd& objective_gr
   const Eigen::VectorXd& b = m_volume_response;
   // lambda solves the bordered system's adjoint: K lambda = dJ/dx - mu v with v^T lambda = 0.
   const Eigen::VectorXd a = m_solver.solve_with_factorization(objective_gradient_x);
-  const Eigen::VectorXd lambda = a - (v.dot(a) / v.dot(b)) * b;
+  const Eigen::VectorXd lambda = a - (v.dot(a) / volume_per_pressure()) * b;
   return -apply_mixed(m_mixed, lambda, true);
 }
 
@@ -29,7 +28,7 @@ void AdjointSensitivity::linear_response(const Eigen::VectorXd& direction, Eigen
   const Eigen::VectorXd& v = m_volume_gradient;
   const Eigen::VectorXd& b = m_volume_response;
   const Eigen::VectorXd a = m_solver.solve_with_factorization(-apply_mixed(m_mixed, direction, false));
-  const double vb = v.dot(b);
+  const double vb = volume_per_pressure();
   dp = std::abs(vb) > 0.0 ? -v.dot(a) / vb : 0.0;
   dx = a + dp * b;
   if (!dx.allFinite()) {

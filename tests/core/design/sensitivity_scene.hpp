@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "fem/balloon_model.hpp"
@@ -31,7 +32,7 @@ inline Positions unflat(const Eigen::VectorXd& x) {
 
 struct Scene {
   TriMesh rest;
-  Material material = *parse_material_spec("silicone");
+  Material material;
   fem::BalloonModel model;
   std::vector<bool> fixed;
   EquilibriumSolver solver;
@@ -59,17 +60,19 @@ struct Scene {
     return model;
   }
 
-  /// `bending`: the sheet's bending hinges on (a thick sheet, so that they matter).
-  explicit Scene(bool bending = false)
-      : rest(ellipsoid()),
-        model(make_model(rest, material, bending ? 2.0 : 0.5, bending)),
+  /// `rest` of `material`, `thickness_mm` thick, inflated `volume_ratio`-fold and settled tightly on this
+  /// scene's solver; `bending`: the sheet's bending hinges on.
+  Scene(TriMesh rest_mesh, const Material& rubber, double thickness_mm, double volume_ratio, bool bending)
+      : rest(std::move(rest_mesh)),
+        material(rubber),
+        model(make_model(rest, material, thickness_mm, bending)),
         fixed(support(rest)),
         solver(model, fixed) {
     InflationOptions inflation;
     inflation.material = material;
-    inflation.thickness_mm = bending ? 2.0 : 0.5;
+    inflation.thickness_mm = thickness_mm;
     inflation.bending = bending ? BendingUse::On : BendingUse::Off;
-    inflation.volume_ratio = 3.0;
+    inflation.volume_ratio = volume_ratio;
     const InflationResult inflated = inflate(rest, inflation);
     EXPECT_TRUE(inflated.converged) << inflated.message;
     x = flat(inflated.deformed);
@@ -81,6 +84,10 @@ struct Scene {
     const NewtonReport report = solver.solve_volume(x, pressure_mpa, target_volume, tight);
     EXPECT_TRUE(report.converged) << report.message;
   }
+
+  /// The silicone ellipsoid inflated 3-fold; with `bending` a thick sheet, so that the hinges matter.
+  explicit Scene(bool bending = false)
+      : Scene(ellipsoid(), *parse_material_spec("silicone"), bending ? 2.0 : 0.5, 3.0, bending) {}
 
   /// The equilibrium of rest shape `rest_x` (flat), from the base equilibrium.
   Eigen::VectorXd equilibrium(const Eigen::VectorXd& rest_x, double* pressure = nullptr) {

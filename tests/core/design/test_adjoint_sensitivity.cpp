@@ -64,29 +64,13 @@ TEST_P(AdjointSensitivityTest, LinearResponseMatchesCentralDifferences) {
 /// 4 pi R^3 l^2 / (dp/dl) at l = ratio^(1/3) (central differences of the sphere law).
 void sphere_volume_per_pressure(const char* material_spec, double ratio, double& computed, double& closed_form) {
   constexpr double RADIUS_MM = 20.0, THICKNESS_MM = 0.5;
-  const TriMesh sphere = make_icosphere(RADIUS_MM, 3);
-  const Material material = *parse_material_spec(material_spec);
-  fem::BalloonModel model(sphere, material, std::vector<double>(static_cast<size_t>(sphere.face_count()), THICKNESS_MM));
-  EquilibriumSolver solver(model, Scene::support(sphere));
-  InflationOptions inflation;
-  inflation.material = material;
-  inflation.thickness_mm = THICKNESS_MM;
-  inflation.bending = BendingUse::Off;
-  inflation.volume_ratio = ratio;
-  const InflationResult inflated = inflate(sphere, inflation);
-  ASSERT_TRUE(inflated.converged) << inflated.message;
-  Eigen::VectorXd x = flat(inflated.deformed);
-  double pressure = 1e-3 * inflated.pressure_kpa;
-  NewtonSettings tight;
-  tight.relative_tolerance = 1e-10;
-  tight.max_iterations = 50;
-  ASSERT_TRUE(solver.solve_volume(x, pressure, enclosed_volume(inflated.deformed, sphere.faces), tight).converged);
-  AdjointSensitivity sensitivity(model, solver);
-  ASSERT_TRUE(sensitivity.prepare(flat(sphere.vertices), x, pressure));
+  Scene scene(make_icosphere(RADIUS_MM, 3), *parse_material_spec(material_spec), THICKNESS_MM, ratio, false);
+  AdjointSensitivity sensitivity(scene.model, scene.solver);
+  ASSERT_TRUE(sensitivity.prepare(flat(scene.rest.vertices), scene.x, scene.pressure_mpa));
   computed = sensitivity.volume_per_pressure();
   const double stretch = std::cbrt(ratio), h = 1e-5;
-  const double slope = (sphere_pressure(material, RADIUS_MM, THICKNESS_MM, stretch + h) -
-                        sphere_pressure(material, RADIUS_MM, THICKNESS_MM, stretch - h)) / (2.0 * h);
+  const double slope = (sphere_pressure(scene.material, RADIUS_MM, THICKNESS_MM, stretch + h) -
+                        sphere_pressure(scene.material, RADIUS_MM, THICKNESS_MM, stretch - h)) / (2.0 * h);
   closed_form = 4.0 * M_PI * std::pow(RADIUS_MM, 3) * stretch * stretch / slope;
 }
 
