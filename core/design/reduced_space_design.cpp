@@ -15,6 +15,7 @@
 #include "design/lbfgs.hpp"
 #include "design/reduced_gauss_newton.hpp"
 #include "design/surface_distance.hpp"
+#include "design/trust_radius.hpp"
 #include "solve/equilibrium_solver.hpp"
 #include "solve/rigid_modes.hpp"
 
@@ -121,8 +122,7 @@ class ReducedSpaceDesign {
     int small_decreases = 0;
     double stall_objective = objective;         // objective at the last real improvement of either
     int stall_iteration = first_iteration - 1;
-    const double max_radius = 0.02 * result.bbox_diag_mm;  // mm
-    double radius = max_radius;
+    TrustRadius trust(0.02 * result.bbox_diag_mm);
     stop_with(result, DesignStop::IterationLimit, "iteration limit reached");
     for (int iteration = first_iteration; iteration <= m_options.max_iterations; ++iteration) {
       if (m_options.cancel && m_options.cancel->cancelled()) {
@@ -152,11 +152,10 @@ class ReducedSpaceDesign {
       // radius and turns the balloon about its pinned coordinates: latex cactus's trials crept from the
       // first iteration on and it stalled at the baseline; without it, 4.9-7.6x. A nozzle pins the rest shape.
       if (m_all_rest_free) direction = without_rigid_motion(rest, direction);
-      // Trust region on the rest shape: no vertex moves more than `radius` (at most 2% of the target's
-      // size) per step. The radius shrinks by as much as the last step needed halving and grows back after
-      // full steps, so a wrinkling region costs one failed equilibrium, not one per iteration.
+      // Trust region on the rest shape: no vertex moves more than the radius (at most 2% of the target's
+      // size) per step, so a wrinkling region costs one failed equilibrium, not one per iteration.
       const double largest = unflatten(direction).rowwise().norm().maxCoeff();
-      double t = largest > radius ? radius / largest : 1.0;
+      double t = largest > trust.radius() ? trust.radius() / largest : 1.0;
       const double first_t = t;
       if (!newton_like && m_lbfgs.empty()) t = std::min(t, 0.002 * result.bbox_diag_mm / std::max(largest, 1e-300));
       const double slope = direction.dot(gradient);
@@ -229,10 +228,9 @@ class ReducedSpaceDesign {
         }
         break;
       }
-      // Cut k times, the radius shrinks by 2^k; it is not set to the step taken: a short direction's step
-      // (a barrier's, 1e-6 mm) that needed one halving had set it there, and the next full-size direction
-      // started at t = 2e-6 and spent the rest of the budget doubling it back (latex teddy, stalled).
-      radius = t < first_t ? radius * (t / first_t) : std::min(max_radius, 2.0 * radius);
+      const double model_decrease = gauss_newton_model_decrease(t, slope);
+      trust.after_step(first_t, t, largest, model_decrease > 0.0 ? (objective - trial_objective) / model_decrease : 1.0,
+                       newton_like);
       const Eigen::VectorXd step = trial_rest - rest;
       rest = trial_rest;
       m_x = trial_x;

@@ -49,5 +49,32 @@ TEST(ReducedGaussNewton, DirectionSolvesTheGaussNewtonSystemOfFiniteDifferenceSe
   std::printf("Gauss-Newton direction: %d CG iterations\n", step.cg_iterations);
 }
 
+/// A conjugate-gradient iterate from zero, even one cut off after a few iterations, has d^T A d = -g^T d,
+/// which is what the design's trust region takes the Gauss-Newton model's predicted decrease from
+/// (`gauss_newton_model_decrease`): checked with J d by central differences of equilibria.
+TEST(ReducedGaussNewton, ATruncatedDirectionsCurvatureIsMinusItsSlope) {
+  Scene scene;
+  const Eigen::VectorXd rest = flat(scene.rest.vertices);
+  const Eigen::VectorXd goal = scene.x + 0.5 * scene.direction(11);
+  scene.model.set_rest_positions(scene.rest.vertices);
+  AdjointSensitivity sensitivity(scene.model, scene.solver);
+  ASSERT_TRUE(sensitivity.prepare(rest, scene.x, scene.pressure_mpa));
+  const std::vector<bool> rest_free(static_cast<size_t>(rest.size()), true);
+  const Eigen::VectorXd w = scene.model.volume_gradient(rest);
+  const Eigen::VectorXd raw = sensitivity.gradient(scene.x - goal);
+  const Eigen::VectorXd gradient = raw - (raw.dot(w) / w.squaredNorm()) * w;
+  const auto identity = [](const Eigen::VectorXd& v) { return v; };
+  const GaussNewtonDirection step = reduced_gauss_newton_direction(sensitivity, identity, gradient, rest_free, w,
+                                                                   identity, 3, 1e-12);
+  ASSERT_EQ(step.cg_iterations, 3) << "cut off before it converged";
+  ASSERT_TRUE(step.descent);
+  constexpr double STEP_MM = 1e-4;
+  const Eigen::VectorXd response =
+      (scene.equilibrium(rest + STEP_MM * step.direction) - scene.equilibrium(rest - STEP_MM * step.direction)) /
+      (2.0 * STEP_MM);
+  const double slope = step.direction.dot(gradient);
+  EXPECT_NEAR(response.squaredNorm(), -slope, 1e-4 * std::abs(slope));
+}
+
 }  // namespace
 }  // namespace balloon
