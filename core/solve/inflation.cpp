@@ -384,7 +384,9 @@ class InflationRun {
       hard_step = report.converged;
       if (report.converged) continue;
       if (stopped(report)) {
-        message = report.message;
+        // Where it got to: the last equilibrium, which the result holds.
+        message = report.message + " at volume ratio " + format_number_short_of(state.volume / m_rest_volume, target_volume / m_rest_volume) +
+                  ", on the way to " + format_number(target_volume / m_rest_volume);
         return false;
       }
       if (creeping_through_wrinkles(report) && switch_bending_on()) {

@@ -14,7 +14,8 @@
 // maximum pressure is physical too ("max", counted apart).
 // Usage: bench_robustness [DATA_DIR] [--mesh SUBSTRING]... [--material silicone|latex|neo-hookean|mooney-rivlin]
 //                         [--resolution N=4000] [--max-time S=120] [--tension-field] [--bending on|off|auto]
-//                         [--pressure-fraction F] [--quick]
+//                         [--pressure-fraction F] [--quick] [--size MM] [--form given|half] [--ratio R]
+//   --size, --form, --ratio: only the cases with this diagonal (mm), form or volume ratio (to rerun one case).
 //   --quick: 200 mm as given, the largest ratio only (one case per mesh and material).
 #include <algorithm>
 #include <chrono>
@@ -75,6 +76,8 @@ int main(int argc, char** argv) {
   bool tension_field = false;
   double pressure_fraction = 0.0;  // > 0: each case under pressure control at this fraction of its volume run's pressure
   balloon::BendingUse bending = balloon::BendingUse::Auto;
+  double only_size = 0.0, only_ratio = 0.0;  // 0: all
+  std::string only_form;                     // empty: both
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     auto value = [&]() -> std::string {
@@ -94,6 +97,9 @@ int main(int argc, char** argv) {
     else if (arg == "--material") material_filters.push_back(value());
     else if (arg == "--resolution") resolution = std::atoi(value().c_str());
     else if (arg == "--max-time") max_time_s = std::atof(value().c_str());
+    else if (arg == "--size") only_size = std::atof(value().c_str());
+    else if (arg == "--ratio") only_ratio = std::atof(value().c_str());
+    else if (arg == "--form") only_form = value();
     else if (arg == "--pressure-fraction") pressure_fraction = std::atof(value().c_str());
     else if (!arg.empty() && arg[0] == '-') {
       std::fprintf(stderr, "unknown option %s\n", arg.c_str());
@@ -147,6 +153,7 @@ int main(int argc, char** argv) {
       continue;
     }
     for (double size : sizes) {
+      if (only_size > 0.0 && size != only_size) continue;
       balloon::TriMesh mesh = *loaded;
       mesh.vertices *= size / balloon::bounding_box_diagonal(mesh.vertices);
       if (resolution > 0 && mesh.vertex_count() > resolution * 5 / 4) {
@@ -162,12 +169,14 @@ int main(int argc, char** argv) {
         mesh = prepared->mesh;
       }
       for (double shrink : shrink_factors) {
+        if (!only_form.empty() && only_form != (shrink == 1.0 ? "given" : "half")) continue;
         const balloon::TriMesh rest = shrink == 1.0 ? mesh : shrunk_about_centroid(mesh, shrink);
         for (const NamedMaterial& m : materials) {
           if (!selected(material_filters, m.label)) continue;
           std::vector<double> ratios = m.ratios;
           if (quick) ratios = {ratios.back()};
           for (double ratio : ratios) {
+            if (only_ratio > 0.0 && ratio != only_ratio) continue;
             balloon::InflationOptions options;
             options.material = m.material;
             options.thickness_mm = 0.5;

@@ -2,9 +2,11 @@
 // material, on both sides of a pressure maximum, and stiff or extreme cases end without NaN.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "core/mesh/mesh_test_helpers.hpp"
 #include "mesh/icosphere.hpp"
@@ -474,6 +476,25 @@ TEST(Inflation, ALongStepReportsItsNewtonIterationsAsItGoes) {
   last_iteration = -1;
   inflate(*mesh, options);
   EXPECT_LT(newton_events, result.newton_iterations);
+}
+
+TEST(Inflation, ATimeLimitSaysHowFarThePathGot) {
+  // A path reaches x2 within its budget, which has run out before it goes on to x8: it stops at once,
+  // holding x2, and says so.
+  auto mesh = read_mesh(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/cube_866.off");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  mesh->vertices *= 100.0 / bounding_box_diagonal(mesh->vertices);
+  InflationOptions options;
+  options.material = *parse_material_spec("silicone");
+  options.max_time_s = 1.0;
+  InflationPath path(*mesh, options);
+  ASSERT_TRUE(path.advance(InflationControl::VolumeRatio, 2.0).converged);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));
+  const InflationResult result = path.advance(InflationControl::VolumeRatio, 8.0);
+  EXPECT_FALSE(result.converged);
+  EXPECT_EQ(result.stop, InflationStop::TimeLimit);
+  EXPECT_NEAR(result.volume_ratio, 2.0, 1e-6);
+  EXPECT_EQ(result.message, "time limit reached at volume ratio 2, on the way to 8");
 }
 
 TEST(Inflation, TensionFieldChangesNothingOnATautSphere) {
