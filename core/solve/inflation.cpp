@@ -402,6 +402,7 @@ class InflationRun {
                   " (" + report.message + ", residual " + format_number(report.residual_norm) + " N against a tolerance of " +
                   format_number(m_settings.relative_tolerance * m_solver.force_scale(state.x, state.pressure)) + " N)";
         if (report.stop == NewtonStop::NonFinite) message += stiffening_overflow(state);
+        message += unstable_path(state);
         return false;
       }
     }
@@ -670,6 +671,19 @@ class InflationRun {
            format_number(state.volume / m_rest_volume) + ", largest stretch " +
            format_number(m_model.max_stretch(state.x)) + ") the pressure was already " + format_kpa(state.pressure) +
            ", far beyond what any rubber bears before it bursts";
+  }
+
+  /// Why a volume path ends short of its target in physical terms when the last equilibrium it reached is
+  /// unstable: empty when that one was stable. Such a path follows saddles (the knot with Mooney-Rivlin
+  /// beyond x3: several bulges along the tube at the plateau pressure, 4-9 unstable modes), and near a fold
+  /// of that branch every step fails while the stable states a real balloon would snap to lie out of reach.
+  std::string unstable_path(const PathPoint& state) const {
+    if (m_unstable_modes <= 0) return "";
+    return "; the last equilibrium reached (volume ratio " + format_number(state.volume / m_rest_volume) + ", " +
+           format_kpa(state.pressure) + ") is unstable, with " + std::to_string(m_unstable_modes) +
+           (m_unstable_modes == 1 ? " direction" : " directions") +
+           " along which the balloon would change shape at that volume by itself: the path had been following "
+           "unstable equilibria, which a real balloon leaves, and no stable one was found";
   }
 
   void fill(InflationResult& result, const PathPoint& state) {
