@@ -481,13 +481,10 @@ TEST(Inflation, ALongStepReportsItsNewtonIterationsAsItGoes) {
 TEST(Inflation, ATimeLimitSaysHowFarThePathGot) {
   // A path reaches x2 within its budget, which has run out before it goes on to x8: it stops at once,
   // holding x2, and says so.
-  auto mesh = read_mesh(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/cube_866.off");
-  ASSERT_TRUE(mesh.ok()) << mesh.error();
-  mesh->vertices *= 100.0 / bounding_box_diagonal(mesh->vertices);
   InflationOptions options;
   options.material = *parse_material_spec("silicone");
   options.max_time_s = 1.0;
-  InflationPath path(*mesh, options);
+  InflationPath path(corpus_mesh("cube_866.off", 100.0), options);
   ASSERT_TRUE(path.advance(InflationControl::VolumeRatio, 2.0).converged);
   std::this_thread::sleep_for(std::chrono::milliseconds(1100));
   const InflationResult result = path.advance(InflationControl::VolumeRatio, 8.0);

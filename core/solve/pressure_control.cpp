@@ -1,0 +1,160 @@
+// InflationRun's pressure control (inflation_run.hpp): the volume path followed until its pressure
+// reaches the target, then the equilibrium at that pressure, or the answer that it lies above the
+// balloon's pressure maximum.
+#include "solve/inflation_run.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "solve/pressure_bracket.hpp"
+#include "solve/quantity_text.hpp"
+
+namespace balloon {
+namespace {
+
+/// Pressure control past a pressure maximum below the target follows the volume path this far (V / V_rest,
+/// issue 14's widest curve) for the pressure to climb back before it calls the target above the maximum.
+constexpr double MAX_VOLUME_RATIO_PAST_A_PEAK = 250.0;
+/// Volume-controlled solves that close the bracket around a target pressure at most (settle_at_pressure).
+constexpr int MAX_BRACKET_STEPS = 40;
+
+}  // namespace
+
+bool InflationRun::inflate_to_pressure(PathPoint& state, double target_pressure, std::string& message) {
+  if (target_pressure <= 0.0) {
+    message = "pressure must be positive";
+    return false;
+  }
+  const double rest_volume = m_rest_volume;
+  double step = 0.5 * rest_volume;
+  // The highest pressure on the path so far, and where; past a maximum below the target the path goes
+  // on, for the pressure may climb again (a lobe that popped, a stiffening rubber's third branch).
+  // `snapped_from`: once the pressure fell, the highest pressure before the latest fall, where a balloon
+  // held at the target pressure snaps (the path's last step, past the target, is no maximum it passed).
+  PathPoint peak = state;
+  std::optional<PathPoint> snapped_from;
+  NewtonReport report;
+  while (state.pressure < target_pressure) {
+    PathPoint previous = state;
+    if (!volume_step(state, state.volume + step, report)) {
+      if (report.stop != NewtonStop::Cancelled && stopped_passing_through_itself(state, message)) {
+        if (snapped_from)
+          message += "; before that " + fall_after(*snapped_from) + ", below the " + format_kpa(target_pressure) + " asked for";
+        return false;
+      }
+      if (stopped(report)) {
+        message = report.message;
+        return false;
+      }
+      if (creeping_through_wrinkles(report) && switch_bending_on()) continue;
+      step *= 0.5;
+      if (step < 1e-5 * rest_volume) {
+        // Past a peak, a path that ends leaves the peak the highest pressure this balloon holds.
+        if (snapped_from) return above_maximum_pressure(state, peak, target_pressure, message);
+        message = "no equilibrium found on the way to " + format_kpa(target_pressure) + " (" + report.message + ")";
+        return false;
+      }
+      continue;
+    }
+    if (state.pressure > peak.pressure) peak = state;
+    if (state.pressure < previous.pressure) snapped_from = peak;
+    if (state.pressure < target_pressure && snapped_from && state.volume > MAX_VOLUME_RATIO_PAST_A_PEAK * rest_volume)
+      return above_maximum_pressure(state, peak, target_pressure, message);
+    if (state.pressure < target_pressure && state.volume > 1e6 * rest_volume) {
+      message = "no equilibrium below volume ratio 1e6 for " + format_kpa(target_pressure);
+      return false;
+    }
+    if (state.pressure >= target_pressure) {
+      if (!settle_at_pressure(state, previous, state, target_pressure, message)) return false;
+      if (snapped_from)
+        m_final_message += "; on the way " + fall_after(*snapped_from) +
+                           ": at that pressure the balloon snaps to a larger shape, and this is the one it reaches";
+      return true;
+    }
+    if (report.iterations <= 6) step *= 2.0;
+  }
+  return true;
+}
+
+std::string InflationRun::fall_after(const PathPoint& peak) const {
+  return "the pressure fell after a maximum of " + format_kpa(peak.pressure) + " at volume ratio " +
+         format_number(peak.volume / m_rest_volume);
+}
+
+bool InflationRun::above_maximum_pressure(PathPoint& state, const PathPoint& peak, double target_pressure, std::string& message) {
+  m_stop = InflationStop::AboveMaximumPressure;
+  message = "no equilibrium: " + format_kpa(target_pressure) + " exceeds the balloon's maximum pressure of about " +
+            format_kpa(peak.pressure) + " (the highest on its volume path up to volume ratio " +
+            format_number(state.volume / m_rest_volume) + "; use volume control to pass it)";
+  state = peak;
+  return false;
+}
+
+bool InflationRun::settle_at_pressure(PathPoint& state, PathPoint low, PathPoint high, double target_pressure, std::string& message) {
+  PressureBracket bracket(m_rest_volume, target_pressure, {low.volume, low.pressure}, {high.volume, high.pressure});
+  NewtonReport report;
+  auto closer_end = [&]() -> PathPoint& {
+    return target_pressure - low.pressure < high.pressure - target_pressure ? low : high;
+  };
+  for (int bracket_step = 0; bracket_step < MAX_BRACKET_STEPS; ++bracket_step) {
+    PathPoint& closer = closer_end();
+    if (m_solver.residual(closer.x, target_pressure).norm() <=
+        m_settings.relative_tolerance * m_solver.force_scale(closer.x, target_pressure)) {
+      state = {closer.x, target_pressure, closer.volume};
+      m_final_message = "converged";
+      return true;
+    }
+    const double volume = bracket.next_volume();
+    const double theta = (volume - low.volume) / (high.volume - low.volume);
+    PathPoint guess{low.x + theta * (high.x - low.x), target_pressure, volume};
+    // From the interpolation, else as the path steps: from the lower end's equilibrium, scaled.
+    PathPoint reached = low;
+    bool solved = volume_step(reached, guess.volume, report, &guess);
+    // A membrane that fails here tries again with the sheet's bending. A target far below the path's
+    // first pressure lies near the rest volume, where a membrane is nearly slack: a rounded box's faces
+    // wrinkled (Mooney-Rivlin, 0.01 kPa), and the dinosaur (latex, 0.05 kPa, x1.008) pillowed at almost
+    // no pressure, its solve creeping to the iteration limit with K positive definite. Its bending
+    // stiffness, which the real sheet has, makes both converge.
+    if (!solved && !stopped(report) && switch_bending_on())
+      solved = volume_step(reached, guess.volume, report, &guess);
+    if (!solved && !stopped(report) && !volume_step(reached, guess.volume, report)) {
+      if (stopped(report)) {
+        message = report.message;
+        state = closer;
+        return false;
+      }
+      // The spool with latex, whose pressure triples between two path points, failed its volume solves
+      // in between.
+      return settle_by_pressure_newton(state, closer, target_pressure, report, message);
+    }
+    (bracket.narrow({reached.volume, reached.pressure}) ? low : high) = reached;
+  }
+  // The volume solves in between landed on other branches (the rotor at half size with latex: p(V) jumps).
+  report.message = "the bracket did not close in " + std::to_string(MAX_BRACKET_STEPS) + " volume steps";
+  report.residual_norm = 0.0;  // each of those converged
+  return settle_by_pressure_newton(state, closer_end(), target_pressure, report, message);
+}
+
+bool InflationRun::settle_by_pressure_newton(PathPoint& state, const PathPoint& closer, double target_pressure,
+                                             const NewtonReport& failed, std::string& message) {
+  Eigen::VectorXd x = closer.x;
+  const NewtonReport at_pressure = m_solver.solve_pressure(x, target_pressure, m_settings);
+  m_newton_iterations += at_pressure.iterations;
+  if (at_pressure.converged) {
+    state = {x, target_pressure, m_model.volume(x)};
+    m_final_message = at_pressure.message;
+    return true;
+  }
+  if (stopped(at_pressure)) {
+    message = at_pressure.message;
+  } else {
+    message = "no equilibrium found at " + format_kpa(target_pressure) + " (" + failed.message +
+              (failed.residual_norm > 0.0 ? ", residual " + format_number(failed.residual_norm) + " N" : "") +
+              "; then at that pressure: " + at_pressure.message + ")";
+  }
+  state = closer;
+  return false;
+}
+
+}  // namespace balloon
