@@ -3,24 +3,22 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
+
+#include "solve/quantity_text.hpp"
 
 namespace balloon {
 namespace {
+
+/// Significant digits of the numbers in the curve's messages (its ranges are typed to more than three).
+constexpr int CURVE_DIGITS = 4;
 
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-std::string format_number(double value) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.4g", value);
-  return buffer;
-}
-
 std::string describe_target(InflationControl control, double target) {
-  return control == InflationControl::Pressure ? format_number(target) + " kPa"
-                                               : "volume ratio " + format_number(target);
+  return control == InflationControl::Pressure ? format_number(target, CURVE_DIGITS) + " kPa"
+                                               : "volume ratio " + format_number(target, CURVE_DIGITS);
 }
 
 /// Vertex of the parabola through three points (abscissae distinct): where a sampled extremum lies.
@@ -59,15 +57,18 @@ std::string curve_range_problem(InflationControl control, double from, double to
            ", got " + std::to_string(points);
   if (!std::isfinite(from) || !std::isfinite(to)) return "the range must be two finite numbers";
   if (control == InflationControl::VolumeRatio) {
-    if (!(from > 1.0)) return "the volume-ratio range must start above 1 (the rest volume), got " + format_number(from);
+    if (!(from > 1.0))
+      return "the volume-ratio range must start above 1 (the rest volume), got " + format_number(from, CURVE_DIGITS);
     if (!(to <= MAX_CURVE_VOLUME_RATIO))
-      return "the volume-ratio range must end at most at " + format_number(MAX_CURVE_VOLUME_RATIO);
+      return "the volume-ratio range must end at most at " + format_number(MAX_CURVE_VOLUME_RATIO, CURVE_DIGITS);
   } else {
-    if (!(from > 0.0)) return "the pressure range must start above 0 kPa, got " + format_number(from);
+    if (!(from > 0.0)) return "the pressure range must start above 0 kPa, got " + format_number(from, CURVE_DIGITS);
     if (!(to <= MAX_CURVE_PRESSURE_KPA))
-      return "the pressure range must end at most at " + format_number(MAX_CURVE_PRESSURE_KPA) + " kPa";
+      return "the pressure range must end at most at " + format_number(MAX_CURVE_PRESSURE_KPA, CURVE_DIGITS) + " kPa";
   }
-  if (!(from < to)) return "the range must be A:B with A < B, got " + format_number(from) + ":" + format_number(to);
+  if (!(from < to))
+    return "the range must be A:B with A < B, got " + format_number(from, CURVE_DIGITS) + ":" +
+           format_number(to, CURVE_DIGITS);
   return "";
 }
 

@@ -4,9 +4,9 @@
 
 namespace balloon {
 
-std::string format_number(double value) {
+std::string format_number(double value, int digits) {
   std::ostringstream out;
-  out.precision(3);
+  out.precision(digits);
   out << value;
   return out.str();
 }
