@@ -282,8 +282,9 @@ bool InflationRun::inflate_to_volume(PathPoint& state, double target_volume, std
     if (report.converged) continue;
     if (stopped(report)) {
       // Where it got to: the last equilibrium, which the result holds.
-      message = report.message + " at volume ratio " + format_number_short_of(state.volume / m_rest_volume, target_volume / m_rest_volume) +
-                ", on the way to " + format_number(target_volume / m_rest_volume);
+      const double reached = state.volume / m_rest_volume, target = target_volume / m_rest_volume;
+      message = report.message + " at volume ratio " + format_number_short_of(reached, target) + ", on the way to " +
+                format_number(target);
       return false;
     }
     if (creeping_through_wrinkles(report) && switch_bending_on()) {
