@@ -21,6 +21,14 @@ constexpr double MAX_VOLUME_RATIO_PAST_A_PEAK = 250.0;
 /// Volume-controlled solves that close the bracket around a target pressure at most (settle_at_pressure).
 constexpr int MAX_BRACKET_STEPS = 40;
 
+/// Where a path stopped by its time limit (or a cancel) got to: "time limit reached at 1.2 kPa (volume
+/// ratio 1.8), on the way to 3 kPa". The result holds that equilibrium.
+std::string stopped_on_the_way(const std::string& reason, const PathPoint& reached, double rest_volume,
+                               double target_pressure) {
+  return reason + " at " + format_kpa(reached.pressure) + " (volume ratio " + format_number(reached.volume / rest_volume) +
+         "), on the way to " + format_kpa(target_pressure);
+}
+
 }  // namespace
 
 bool InflationRun::inflate_to_pressure(PathPoint& state, double target_pressure, std::string& message) {
@@ -46,7 +54,7 @@ bool InflationRun::inflate_to_pressure(PathPoint& state, double target_pressure,
         return false;
       }
       if (stopped(report)) {
-        message = report.message;
+        message = stopped_on_the_way(report.message, state, m_rest_volume, target_pressure);
         return false;
       }
       if (creeping_through_wrinkles(report) && switch_bending_on()) continue;
@@ -122,8 +130,8 @@ bool InflationRun::settle_at_pressure(PathPoint& state, PathPoint low, PathPoint
       solved = volume_step(reached, guess.volume, report, &guess);
     if (!solved && !stopped(report) && !volume_step(reached, guess.volume, report)) {
       if (stopped(report)) {
-        message = report.message;
         state = closer;
+        message = stopped_on_the_way(report.message, state, m_rest_volume, target_pressure);
         return false;
       }
       // The spool with latex, whose pressure triples between two path points, failed its volume solves
@@ -149,7 +157,7 @@ bool InflationRun::settle_by_pressure_newton(PathPoint& state, const PathPoint& 
     return true;
   }
   if (stopped(at_pressure)) {
-    message = at_pressure.message;
+    message = stopped_on_the_way(at_pressure.message, closer, m_rest_volume, target_pressure);
   } else {
     message = "no equilibrium found at " + format_kpa(target_pressure) + " (" + failed.message +
               (failed.residual_norm > 0.0 ? ", residual " + format_number(failed.residual_norm) + " N" : "") +

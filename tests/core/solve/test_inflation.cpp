@@ -14,6 +14,7 @@
 #include "mesh/mesh_geometry.hpp"
 #include "mesh/mesh_io.hpp"
 #include "solve/inflation.hpp"
+#include "solve/quantity_text.hpp"
 
 namespace balloon {
 namespace {
@@ -492,6 +493,25 @@ TEST(Inflation, ATimeLimitSaysHowFarThePathGot) {
   EXPECT_EQ(result.stop, InflationStop::TimeLimit);
   EXPECT_NEAR(result.volume_ratio, 2.0, 1e-6);
   EXPECT_EQ(result.message, "time limit reached at volume ratio 2, on the way to 8");
+}
+
+TEST(Inflation, APressureControlledTimeLimitSaysHowFarThePathGot) {
+  // As above under pressure control: the path holds x2 and names its pressure, volume and target.
+  InflationOptions options;
+  options.material = *parse_material_spec("silicone");
+  options.max_time_s = 1.0;
+  InflationPath path(corpus_mesh("cube_866.off", 100.0), options);
+  const InflationResult at_two = path.advance(InflationControl::VolumeRatio, 2.0);
+  ASSERT_TRUE(at_two.converged);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));
+  const double target_kpa = 1.5 * at_two.pressure_kpa;
+  const InflationResult result = path.advance(InflationControl::Pressure, target_kpa);
+  EXPECT_FALSE(result.converged);
+  EXPECT_EQ(result.stop, InflationStop::TimeLimit);
+  EXPECT_NEAR(result.volume_ratio, 2.0, 1e-6);
+  EXPECT_NEAR(result.pressure_kpa, at_two.pressure_kpa, 1e-9 * at_two.pressure_kpa);
+  EXPECT_EQ(result.message, "time limit reached at " + format_kpa(at_two.pressure_kpa * MPA_PER_KPA) +
+                                " (volume ratio 2), on the way to " + format_kpa(target_kpa * MPA_PER_KPA));
 }
 
 TEST(Inflation, TensionFieldChangesNothingOnATautSphere) {
