@@ -101,6 +101,10 @@ class InflationRun {
   /// shape. (The first step of a 14k-vertex teddy with latex to x27 takes tens of seconds.)
   void report_newton_progress(int iteration, double residual_norm, double pressure_mpa);
 
+  /// Where a volume step from `state` to `target_volume` starts: the scaled shape (and the path
+  /// predictor's secant and pressure, when on).
+  PathPoint predicted_start(const PathPoint& state, double target_volume) const;
+
   /// One volume step, from the predictor or from `resume` (the end of an unfinished attempt at the same
   /// volume); updates `state` on success and `m_unfinished` on failure.
   /// `max_iterations` > 0 caps this attempt's Newton steps below the path's own limit.
@@ -149,7 +153,8 @@ class InflationRun {
   bool early_bent_try_available() const;
 
   /// Once per path, the first volume step that creeps through wrinkles as a membrane is tried again with
-  /// the sheet's bending on, from where it started. True if that converged (bending then stays on); else
+  /// the sheet's bending on, from where the membrane attempt stood (from where the step started if the
+  /// walls had passed through each other there). True if that converged (bending then stays on); else
   /// the sheet is a membrane again, with its unfinished attempt as before. `report` becomes the bent
   /// attempt's when that converged or was stopped (time limit, cancel), and stays the membrane's otherwise.
   /// A failed try that was still converging leaves its end in m_bent_try.unfinished, which the attempt

@@ -330,7 +330,14 @@ TEST_P(CorpusInflationTest, ConvergesToTheVolumeRatio) {
   const InflationResult result = inflate_corpus_mesh(c.file, 200.0, c.material, c.volume_ratio);
   ASSERT_EQ(inflation_stop_word(result.stop), std::string(inflation_stop_word(c.expected))) << c.label << ": " << result.message;
   EXPECT_EQ(result.converged, c.expected == InflationStop::Converged);
-  EXPECT_NEAR(result.volume_ratio, c.volume_ratio, 1e-6 * c.volume_ratio);
+  if (c.expected == InflationStop::Converged) {
+    EXPECT_NEAR(result.volume_ratio, c.volume_ratio, 1e-6 * c.volume_ratio);
+  } else {
+    // Where the walls first touch on the way, or at the target (the knot's tube thickens into itself
+    // from about x3.3 on, so either is that answer).
+    EXPECT_GT(result.volume_ratio, 1.0);
+    EXPECT_LE(result.volume_ratio, c.volume_ratio * (1.0 + 1e-6));
+  }
   EXPECT_GT(result.pressure_kpa, 0.0);
   EXPECT_TRUE(result.deformed.allFinite());
 }
@@ -565,6 +572,15 @@ TEST(Inflation, AStepThatCreepsThroughWrinklesTriesTheSheetsBendingAtOnce) {
   EXPECT_TRUE(result.bending);
   EXPECT_NEAR(result.volume_ratio, 2.0, 2e-6);
   EXPECT_LT(result.newton_iterations, 60);
+}
+
+TEST(Inflation, TheEarlyBentTryGoesOnFromWhereTheMembraneStood) {
+  // The blob (200 mm, Neo-Hookean) to x8 in one step: 20 membrane steps creep through wrinkles, then the
+  // sheet's bending converges. Started again from the predictor, the bent try took 14 more Newton steps
+  // (34 in all); from where the membrane stood, 3 (23).
+  const InflationResult result = inflate_corpus_mesh("blobby.off", 200.0, "neo-hookean:mu=0.3", 8.0);
+  EXPECT_TRUE(result.bending);
+  expect_converges_within(result, 8.0, 28);
 }
 
 TEST(Inflation, ShiftedStepsPastAPressureMaximumHandOverToTheExactStep) {
