@@ -153,9 +153,9 @@ class InflationRun {
   bool early_bent_try_available() const;
 
   /// Once per path, the first volume step that creeps through wrinkles as a membrane is tried again with
-  /// the sheet's bending on, from where the membrane attempt stood when bending leaves that nearer
-  /// equilibrium than the predictor and its walls have not passed through each other there (else from
-  /// the predictor). True if that converged (bending then stays on); else the sheet is a membrane
+  /// the sheet's bending on, from where the membrane attempt stood unless bending leaves that far from
+  /// equilibrium (10 times the predictor's residual) or its walls have passed through each other there
+  /// (else from the predictor). True if that converged (bending then stays on); else the sheet is a membrane
   /// again, with its unfinished attempt as before. `report` becomes the bent
   /// attempt's when that converged or was stopped (time limit, cancel), and stays the membrane's otherwise.
   /// A failed try that was still converging leaves its end in m_bent_try.unfinished, which the attempt
