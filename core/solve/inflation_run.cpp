@@ -223,12 +223,15 @@ PathPoint InflationRun::predicted_start(const PathPoint& state, double target_vo
   return start;
 }
 
+double InflationRun::start_pressure(const PathPoint& start) const {
+  return start.pressure != 0.0 ? start.pressure : estimate_pressure(start.x);
+}
+
 bool InflationRun::volume_step(PathPoint& state, double target_volume, NewtonReport& report, const PathPoint* resume,
                                int max_iterations) {
   const PathPoint start = resume ? *resume : predicted_start(state, target_volume);
   Eigen::VectorXd x = start.x;
-  double pressure = start.pressure;
-  if (pressure == 0.0) pressure = estimate_pressure(x);
+  double pressure = start_pressure(start);
   m_unfinished_start_residual = m_solver.residual(x, pressure).norm();
   NewtonSettings settings = m_settings;
   if (max_iterations > 0) settings.max_iterations = max_iterations;
@@ -367,14 +370,13 @@ bool InflationRun::try_bending_early(PathPoint& state, double next_volume, Newto
   // through each other (a bent equilibrium found from there keeps them so: femur x8, dino and anchor with
   // latex), nor where its sharp folds load the hinges far more than the predictor's residual (the dino at
   // 20 mm, latex x2: 235 N there, 1.6 N at the predictor).
-  auto bent_residual = [&](const PathPoint& point) {
-    return m_solver.residual(point.x, point.pressure != 0.0 ? point.pressure : estimate_pressure(point.x)).norm();
-  };
+  const PathPoint predicted = predicted_start(state, next_volume);
+  auto bent_residual = [&](const PathPoint& point) { return m_solver.residual(point.x, start_pressure(point)).norm(); };
   const bool from_membrane_end = membrane_unfinished.volume == next_volume && membrane_unfinished.x.size() > 0 &&
                                  bent_residual(membrane_unfinished) <
-                                     BENT_START_RESIDUAL_FACTOR * bent_residual(predicted_start(state, next_volume)) &&
+                                     BENT_START_RESIDUAL_FACTOR * bent_residual(predicted) &&
                                  !passes_through_itself(m_rest, unflatten(membrane_unfinished.x));
-  if (volume_step(state, next_volume, bent, from_membrane_end ? &membrane_unfinished : nullptr)) {
+  if (volume_step(state, next_volume, bent, from_membrane_end ? &membrane_unfinished : &predicted)) {
     report = bent;
     return true;
   }

@@ -105,8 +105,12 @@ class InflationRun {
   /// predictor's secant and pressure, when on).
   PathPoint predicted_start(const PathPoint& state, double target_volume) const;
 
+  /// The pressure a volume step starts from: the start's own, or the least-squares estimate for its
+  /// shape where it has none (the stress-free sheet).
+  double start_pressure(const PathPoint& start) const;
+
   /// One volume step, from the predictor or from `resume` (the end of an unfinished attempt at the same
-  /// volume); updates `state` on success and `m_unfinished` on failure.
+  /// volume, or a predictor already computed); updates `state` on success and `m_unfinished` on failure.
   /// `max_iterations` > 0 caps this attempt's Newton steps below the path's own limit.
   bool volume_step(PathPoint& state, double target_volume, NewtonReport& report, const PathPoint* resume = nullptr,
                    int max_iterations = 0);
