@@ -22,6 +22,11 @@ constexpr int TRIAL_NEWTON_ITERATIONS = 10;
 constexpr int PATIENT_TRIAL_NEWTON_ITERATIONS = 30;
 /// A trial whose Newton stagnates within this many force tolerances (NewtonSettings) is an equilibrium.
 constexpr double TRIAL_STAGNATION_FACTOR = 10.0;
+/// A trial's predictor whose residual is this many times the force scale (the pressure's) is out of range.
+/// On the silicone corpus the trials that converged started at up to 1e7 times; all but one of those that
+/// failed at the Newton limit (30 steps each), at 1e20-1e89 times (Hart-Smith's exponential past the
+/// linear range).
+constexpr double PREDICTOR_RESIDUAL_LIMIT = 1e10;
 
 Positions scaled_about_centroid(const Positions& points, double scale) {
   const Eigen::RowVector3d center = points.colwise().mean();
@@ -240,6 +245,15 @@ bool DesignDriver::equilibrium(const Eigen::VectorXd& rest, Eigen::VectorXd& x, 
   }
   m_last_report = m_solver.solve_volume(x, pressure, m_target_volume, settings);
   return m_last_report.converged;
+}
+
+bool DesignDriver::trial_start_in_range(const Eigen::VectorXd& rest, const Eigen::VectorXd& x, double pressure) {
+  m_model.set_rest_positions(unflatten(rest));
+  const double residual = m_solver.residual(x, pressure).norm();
+  const double scale = m_solver.force_scale(x, pressure);
+  if (std::getenv("BALLOON_DEBUG_DESIGN"))
+    std::fprintf(stderr, "  trial start residual %.3g N, force scale %.3g N\n", residual, scale);
+  return std::isfinite(residual) && residual <= PREDICTOR_RESIDUAL_LIMIT * scale;
 }
 
 bool DesignDriver::stopped() const {

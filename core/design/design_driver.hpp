@@ -74,6 +74,10 @@ class DesignDriver {
   /// Volume-controlled equilibrium of `rest` from (x, p) with a short Newton budget; false when it does
   /// not converge (last_report() says why).
   bool equilibrium(const Eigen::VectorXd& rest, Eigen::VectorXd& x, double& pressure);
+  /// Whether a trial's start (x, pressure) with `rest` is worth Newton steps: false where its residual is
+  /// non-finite or beyond 1e10 times the force scale (PREDICTOR_RESIDUAL_LIMIT: a predictor carried past the
+  /// linear range, where a stiffening rubber's forces explode).
+  bool trial_start_in_range(const Eigen::VectorXd& rest, const Eigen::VectorXd& x, double pressure);
   /// Whether the last Newton solve stopped on the cancel token or the deadline.
   bool stopped() const;
 

@@ -172,6 +172,11 @@ class ReducedSpaceDesign {
         trial_rest = m_driver.keep_rest_volume(rest + t * direction, m_driver.rest_volume(rest));
         trial_x = m_x + t * response;
         trial_pressure = m_pressure + t * pressure_response;
+        if (!m_driver.trial_start_in_range(trial_rest, trial_x, trial_pressure)) {
+          if (std::getenv("BALLOON_DEBUG_DESIGN"))
+            std::fprintf(stderr, "  it %d trial %d t=%.3g: the predictor is out of range\n", iteration, k, t);
+          continue;
+        }
         const bool balanced = m_driver.equilibrium(trial_rest, trial_x, trial_pressure);
         if (std::getenv("BALLOON_DEBUG_DESIGN"))
           std::fprintf(stderr, "  it %d trial %d t=%.3g newton %d %s (%.2f s)\n", iteration, k, t,

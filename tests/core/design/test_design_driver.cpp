@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 
 #include "design/design_driver.hpp"
 #include "design_test_meshes.hpp"
@@ -39,6 +40,28 @@ TEST(DesignDriver, SwitchingBendingOnKeepsAnEquilibriumAndListsTheTerm) {
 
   EXPECT_FALSE(driver.switch_bending_on(rest, result)) << "once only";
   EXPECT_EQ(std::count(result.active_terms.begin(), result.active_terms.end(), "sheet_bending"), 1);
+}
+
+TEST(DesignDriver, ATrialStartFarPastTheLinearRangeIsNotWorthNewtonSteps) {
+  // A first-order predictor carried far past the linear range puts a stiffening rubber into its
+  // exponential: such trials started at 1e20-1e37 N and spent 30 Newton steps each without converging.
+  const TriMesh target = design_test::inflated_ellipsoid_target(2, 1.0);
+  const DesignOptions options = ellipsoid_options(DesignMethod::Adjoint);
+  DesignDriver driver(target, options);
+  DesignResult result = driver.begin(DesignMethod::Adjoint);
+  const Eigen::VectorXd rest = flat(driver.start().vertices);
+  ASSERT_TRUE(driver.inflate_start(rest, result)) << result.message;
+  const Eigen::VectorXd x = driver.x();
+  const double pressure = driver.pressure();
+
+  EXPECT_TRUE(driver.trial_start_in_range(rest, x, pressure)) << "the equilibrium itself";
+  // An ordinary trial: every rest vertex moved by 1% of the rest shape's size, the inflated shape kept.
+  EXPECT_TRUE(driver.trial_start_in_range(1.01 * rest, x, pressure));
+  // The same inflated shape over a rest shape a quarter the size: Hart-Smith's exponential at 4x the stretch.
+  EXPECT_FALSE(driver.trial_start_in_range(0.25 * rest, x, pressure));
+  Eigen::VectorXd broken = x;
+  broken[0] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(driver.trial_start_in_range(rest, broken, pressure));
 }
 
 TEST(DesignDriver, TheAugmentedLagrangianKeepsAMembrane) {
