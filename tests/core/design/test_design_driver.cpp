@@ -1,4 +1,5 @@
-// The design driver's steps that the optimizers share: here, switching the sheet's bending on mid-design.
+// The design driver's steps that the optimizers share: switching the sheet's bending on mid-design, judging a
+// trial's start, and going back to the best design.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -19,12 +20,28 @@ DesignOptions ellipsoid_options(DesignMethod method) {
   return options;
 }
 
+/// A driver on that ellipsoid with its result begun; the driver keeps references to the target and options
+/// held here.
+struct EllipsoidDesign {
+  explicit EllipsoidDesign(DesignMethod method)
+      : target(design_test::inflated_ellipsoid_target(2, 1.0)),
+        options(ellipsoid_options(method)),
+        driver(target, options),
+        result(driver.begin(method)),
+        start(flat(driver.start().vertices)) {}
+
+  const TriMesh target;
+  const DesignOptions options;
+  DesignDriver driver;
+  DesignResult result;
+  const Eigen::VectorXd start;  // the start rest shape
+};
+
 TEST(DesignDriver, SwitchingBendingOnKeepsAnEquilibriumAndListsTheTerm) {
-  const TriMesh target = design_test::inflated_ellipsoid_target(2, 1.0);
-  const DesignOptions options = ellipsoid_options(DesignMethod::Adjoint);
-  DesignDriver driver(target, options);  // keeps a reference to both
-  DesignResult result = driver.begin(DesignMethod::Adjoint);
-  const Eigen::VectorXd rest = flat(driver.start().vertices);
+  EllipsoidDesign design(DesignMethod::Adjoint);
+  DesignDriver& driver = design.driver;
+  DesignResult& result = design.result;
+  const Eigen::VectorXd& rest = design.start;
   ASSERT_TRUE(driver.inflate_start(rest, result)) << result.message;
   ASSERT_FALSE(driver.model().bending()) << "a smooth ellipsoid inflates as a membrane";
   const Eigen::VectorXd membrane_x = driver.x();
@@ -45,12 +62,10 @@ TEST(DesignDriver, SwitchingBendingOnKeepsAnEquilibriumAndListsTheTerm) {
 TEST(DesignDriver, ATrialStartFarPastTheLinearRangeIsNotWorthNewtonSteps) {
   // A first-order predictor carried far past the linear range puts a stiffening rubber into its
   // exponential: such trials started at 1e20-1e37 N and spent 30 Newton steps each without converging.
-  const TriMesh target = design_test::inflated_ellipsoid_target(2, 1.0);
-  const DesignOptions options = ellipsoid_options(DesignMethod::Adjoint);
-  DesignDriver driver(target, options);
-  DesignResult result = driver.begin(DesignMethod::Adjoint);
-  const Eigen::VectorXd rest = flat(driver.start().vertices);
-  ASSERT_TRUE(driver.inflate_start(rest, result)) << result.message;
+  EllipsoidDesign design(DesignMethod::Adjoint);
+  DesignDriver& driver = design.driver;
+  const Eigen::VectorXd& rest = design.start;
+  ASSERT_TRUE(driver.inflate_start(rest, design.result)) << design.result.message;
   const Eigen::VectorXd x = driver.x();
   const double pressure = driver.pressure();
 
@@ -65,25 +80,19 @@ TEST(DesignDriver, ATrialStartFarPastTheLinearRangeIsNotWorthNewtonSteps) {
 }
 
 TEST(DesignDriver, TheAugmentedLagrangianKeepsAMembrane) {
-  const TriMesh target = design_test::inflated_ellipsoid_target(2, 1.0);
-  const DesignOptions options = ellipsoid_options(DesignMethod::AugmentedLagrangian);
-  DesignDriver driver(target, options);
-  DesignResult result = driver.begin(DesignMethod::AugmentedLagrangian);
-  const Eigen::VectorXd rest = flat(driver.start().vertices);
-  ASSERT_TRUE(driver.inflate_start(rest, result)) << result.message;
-  EXPECT_FALSE(driver.switch_bending_on(rest, result)) << "its derivatives are membrane-only";
-  EXPECT_FALSE(driver.model().bending());
+  EllipsoidDesign design(DesignMethod::AugmentedLagrangian);
+  ASSERT_TRUE(design.driver.inflate_start(design.start, design.result)) << design.result.message;
+  EXPECT_FALSE(design.driver.switch_bending_on(design.start, design.result)) << "its derivatives are membrane-only";
+  EXPECT_FALSE(design.driver.model().bending());
 }
 
 TEST(DesignDriver, RestoreBestHandsBackTheStartWhenTheCurrentShapeIsFartherFromTheTarget) {
   // What both optimizers end with: the augmented Lagrangian's final equilibrium can inflate farther from
   // the target than its start (cactus, latex, 10 s: 3.22 mm against 3.10 mm); the start comes back then.
-  const TriMesh target = design_test::inflated_ellipsoid_target(2, 1.0);
-  const DesignOptions options = ellipsoid_options(DesignMethod::AugmentedLagrangian);
-  DesignDriver driver(target, options);
-  DesignResult result = driver.begin(DesignMethod::AugmentedLagrangian);
-  const Eigen::VectorXd start = flat(driver.start().vertices);
-  ASSERT_TRUE(driver.inflate_start(start, result)) << result.message;
+  EllipsoidDesign design(DesignMethod::AugmentedLagrangian);
+  DesignDriver& driver = design.driver;
+  const Eigen::VectorXd& start = design.start;
+  ASSERT_TRUE(driver.inflate_start(start, design.result)) << design.result.message;
   const Eigen::VectorXd start_x = driver.x();
 
   Eigen::VectorXd rest = start;
@@ -98,19 +107,17 @@ TEST(DesignDriver, RestoreBestHandsBackTheStartWhenTheCurrentShapeIsFartherFromT
 TEST(DesignDriver, RestoreBestEquilibriumHandsBackTheStartEvenWhereTheCurrentShapeLooksCloser) {
   // The augmented Lagrangian's final inflation may find no equilibrium: whatever its unbalanced shape's
   // error, the start (a true equilibrium) comes back.
-  const TriMesh target = design_test::inflated_ellipsoid_target(2, 1.0);
-  const DesignOptions options = ellipsoid_options(DesignMethod::AugmentedLagrangian);
-  DesignDriver driver(target, options);
-  DesignResult result = driver.begin(DesignMethod::AugmentedLagrangian);
-  Eigen::VectorXd rest = flat(driver.start().vertices);
+  EllipsoidDesign design(DesignMethod::AugmentedLagrangian);
+  DesignDriver& driver = design.driver;
+  Eigen::VectorXd rest = design.start;
   EXPECT_FALSE(driver.restore_best_equilibrium(rest)) << "nothing recorded before the start is inflated";
-  const Eigen::VectorXd start = rest;
-  ASSERT_TRUE(driver.inflate_start(start, result)) << result.message;
+  const Eigen::VectorXd& start = design.start;
+  ASSERT_TRUE(driver.inflate_start(start, design.result)) << design.result.message;
   const Eigen::VectorXd start_x = driver.x();
   const double start_pressure = driver.pressure();
 
   rest = 1.01 * start;
-  driver.x() = flat(target.vertices);  // on the target itself: closer than any equilibrium, but unbalanced
+  driver.x() = flat(design.target.vertices);  // on the target itself: closer than any equilibrium, but unbalanced
   EXPECT_FALSE(driver.restore_best(rest)) << "restore_best keeps a closer shape";
   EXPECT_TRUE(driver.restore_best_equilibrium(rest));
   EXPECT_EQ(rest, start);
