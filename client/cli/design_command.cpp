@@ -183,6 +183,19 @@ std::string summary_from_report(const v1::DesignReport& report, const std::strin
       << " mm (the downscaled target inflated)\n";
   out << "  inflation      " << shown_number(report.has_pressure_kpa(), report.pressure_kpa(), "%.5g")
       << " kPa, volume ratio " << shown_number(report.has_volume_ratio(), report.volume_ratio(), "%.4g") << ", " << report.vertices() << " vertices\n";
+  if (report.has_from_rest()) {
+    const v1::RestInflationCheck& check = report.from_rest();
+    out << "  from rest      ";
+    if (check.converged())
+      out << (check.another_shape() ? "ANOTHER SHAPE: " : "the design's shape: ") << "avg "
+          << shown_number(check.has_avg_error_mm(), check.avg_error_mm(), "%.4g") << " mm ("
+          << shown_number(check.has_avg_error_rel(), check.avg_error_rel(), "%.3g", 100.0) << "%) at "
+          << shown_number(check.has_pressure_kpa(), check.pressure_kpa(), "%.5g") << " kPa, "
+          << shown_number(check.has_deviation_mm(), check.deviation_mm(), "%.3g")
+          << " mm from the design's shape (inflated as balloon simulate does)\n";
+    else
+      out << check.message() << "\n";
+  }
   if (report.has_tolerance() && report.tolerance().levels_size() > 0) {
     out << "  tolerance     ";
     for (const v1::ToleranceLevel& level : report.tolerance().levels())

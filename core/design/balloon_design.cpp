@@ -7,6 +7,7 @@
 #include "design/design_driver.hpp"
 #include "design/multiresolution_design.hpp"
 #include "design/reduced_space_design.hpp"
+#include "design/rest_inflation_check.hpp"
 #include "material/thin_sheet.hpp"
 #include "mesh/mesh_geometry.hpp"
 
@@ -70,6 +71,37 @@ std::string options_problem(const TriMesh& target, const DesignOptions& options)
   return "";
 }
 
+DesignResult run_optimizer(const TriMesh& target, const DesignOptions& options) {
+  if (runs_coarse_to_fine(target, options)) return design_coarse_to_fine(target, options);
+  DesignDriver driver(target, options);
+  if (options.method == DesignMethod::AugmentedLagrangian) return run_augmented_lagrangian_design(driver);
+  return run_reduced_space_design(driver);
+}
+
+/// Inflates the design's rest shape from rest as `balloon simulate` would (rest_inflation_check.hpp);
+/// nothing when there is no design or the run was cancelled.
+void add_rest_inflation_check(const TriMesh& target, const DesignOptions& options, DesignResult& result) {
+  const bool have_design = result.avg_error_mm && result.volume_ratio && result.rest.vertex_count() > 0 &&
+                           result.inflated.rows() == result.rest.vertex_count();
+  if (!have_design || result.stop == DesignStop::Cancelled) return;
+  if (options.progress) {
+    ProgressEvent event;
+    event.phase = "check";
+    event.elapsed_s = result.time_s;
+    options.progress(event);
+  }
+  InflationOptions inflation;  // the forward solver's own path settings, as balloon simulate uses them
+  inflation.material = options.material;
+  inflation.thickness_mm = options.thickness_mm;
+  inflation.control = InflationControl::VolumeRatio;
+  inflation.volume_ratio = *result.volume_ratio;
+  inflation.fixed_vertices = options.nozzle_vertices;
+  inflation.max_time_s = REST_INFLATION_CHECK_TIME_LIMIT_S;
+  inflation.cancel = options.cancel;
+  result.from_rest = check_inflation_from_rest(result.rest, inflation, result.inflated, *result.avg_error_mm,
+                                               SurfaceDistance(target), target.vertices);
+}
+
 }  // namespace
 
 double design_start_scale(const DesignOptions& options) {
@@ -88,10 +120,9 @@ DesignResult design_balloon(const TriMesh& target, const DesignOptions& options)
     result.inflated = target.vertices;
     return result;
   }
-  if (runs_coarse_to_fine(target, options)) return design_coarse_to_fine(target, options);
-  DesignDriver driver(target, options);
-  if (options.method == DesignMethod::AugmentedLagrangian) return run_augmented_lagrangian_design(driver);
-  return run_reduced_space_design(driver);
+  DesignResult result = run_optimizer(target, options);
+  if (options.check_from_rest) add_rest_inflation_check(target, options, result);
+  return result;
 }
 
 }  // namespace balloon

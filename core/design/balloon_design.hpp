@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "design/rest_inflation_check.hpp"
 #include "material/material.hpp"
 #include "mesh/tri_mesh.hpp"
 #include "progress.hpp"
@@ -83,6 +84,9 @@ struct DesignOptions {
   int coarse_vertices = 0;
   /// The coarse stage's share of max_time_s (when there is a budget).
   double coarse_time_fraction = 0.5;
+  /// After the design, inflate its rest shape from rest as `balloon simulate` does and compare
+  /// (DesignResult::from_rest); costs one forward inflation, outside max_time_s.
+  bool check_from_rest = true;
   int progress_mesh_every = 5;          ///< attach the inflated mesh to every K-th progress event
   ProgressCallback progress;            ///< optional; phases "start", "design"
   const CancelToken* cancel = nullptr;  ///< optional; checked between iterations
@@ -142,6 +146,9 @@ struct DesignResult {
   std::vector<std::string> active_terms;
   std::vector<ConvergenceSample> log;   ///< full-resolution iterations only (times include the coarse stage)
   std::optional<CoarseStage> coarse_stage;  ///< set when the design ran coarse-to-fine
+  /// The rest shape inflated from rest as `balloon simulate` does (DesignOptions::check_from_rest); none
+  /// without a design or with the check off.
+  std::optional<RestInflationCheck> from_rest;
 };
 
 /// Designs the rest shape for `target`. Never throws for bad numerics: failures are in the result.

@@ -1,5 +1,7 @@
 #include "design/design_driver.hpp"
 
+#include "design/rest_inflation_check.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -108,11 +110,7 @@ bool DesignDriver::inflate_start(const Eigen::VectorXd& rest, DesignResult& resu
   return true;
 }
 
-bool DesignDriver::inflate_start_to_target_volume(const Eigen::VectorXd& rest, DesignResult& result) {
-  m_model.set_rest_positions(unflatten(rest));
-  // The forward solver's own volume path (step control, resumed creeping steps, and the sheet's bending
-  // where the membrane alone wrinkles with no stable state), on the same rigid support as this driver's
-  // solver, to the design's tolerance.
+InflationOptions DesignDriver::inflation_from_rest(const Eigen::VectorXd& rest) const {
   InflationOptions inflation;
   inflation.material = m_model.material();
   inflation.element_thickness_mm.resize(static_cast<size_t>(m_model.faces().rows()));
@@ -120,13 +118,22 @@ bool DesignDriver::inflate_start_to_target_volume(const Eigen::VectorXd& rest, D
   inflation.control = InflationControl::VolumeRatio;
   inflation.volume_ratio = m_target_volume / rest_volume(rest);
   inflation.residual_tolerance = m_settings.relative_tolerance;
-  inflation.sqp_shift_restart = m_settings.shift_restart;
-  inflation.sqp_shift_after_cut_short = m_settings.shift_after_cut_short;
   inflation.reject_self_intersection = false;  // the design moves the shape away from itself
-  // The augmented Lagrangian assembles membrane-only derivatives: no bending there.
-  inflation.bending = m_options.method == DesignMethod::Adjoint ? BendingUse::Auto : BendingUse::Off;
   inflation.cancel = m_options.cancel;
   if (m_settings.deadline_s > 0) inflation.max_time_s = std::max(1e-3, m_settings.deadline_s - design_clock_s());
+  return inflation;
+}
+
+bool DesignDriver::inflate_start_to_target_volume(const Eigen::VectorXd& rest, DesignResult& result) {
+  m_model.set_rest_positions(unflatten(rest));
+  // The forward solver's own volume path (step control, resumed creeping steps, and the sheet's bending
+  // where the membrane alone wrinkles with no stable state), on the same rigid support as this driver's
+  // solver, to the design's tolerance.
+  InflationOptions inflation = inflation_from_rest(rest);
+  inflation.sqp_shift_restart = m_settings.shift_restart;
+  inflation.sqp_shift_after_cut_short = m_settings.shift_after_cut_short;
+  // The augmented Lagrangian assembles membrane-only derivatives: no bending there.
+  inflation.bending = m_options.method == DesignMethod::Adjoint ? BendingUse::Auto : BendingUse::Off;
   const TriMesh rest_mesh{unflatten(rest), m_model.faces()};
   const InflationResult inflated = inflate(rest_mesh, inflation);
   if (!inflated.converged) {
@@ -245,6 +252,30 @@ bool DesignDriver::equilibrium(const Eigen::VectorXd& rest, Eigen::VectorXd& x, 
   }
   m_last_report = m_solver.solve_volume(x, pressure, m_target_volume, settings);
   return m_last_report.converged;
+}
+
+bool DesignDriver::take_shape_from_rest(const Eigen::VectorXd& rest) {
+  m_model.set_rest_positions(unflatten(rest));
+  // The forward solver's own path settings, as balloon simulate uses them (the start keeps the design's).
+  InflationOptions inflation = inflation_from_rest(rest);
+  inflation.fixed_vertices = m_options.nozzle_vertices;
+  const InflationResult inflated = inflate(TriMesh{unflatten(rest), m_model.faces()}, inflation);
+  if (!inflated.converged) return false;
+  const Positions current = unflatten(m_x);
+  const double deviation = SurfaceDistance(TriMesh{current, m_model.faces()}).aligned_stats(inflated.deformed, current).avg_mm;
+  const double error = m_objective.surface().aligned_stats(current, m_target.vertices).avg_mm;
+  if (std::getenv("BALLOON_DEBUG_DESIGN"))
+    std::fprintf(stderr, "  from rest: %.3g mm from the design's shape (its error %.3g mm), %.4g kPa against %.4g kPa\n",
+                 deviation, error, inflated.pressure_kpa, m_pressure / MPA_PER_KPA);
+  if (deviation <= std::max(error, ANOTHER_SHAPE_MIN_REL * m_objective.surface().bbox_diagonal_mm())) return false;
+  if (inflated.bending && !m_model.bending()) set_bending(true);
+  Eigen::VectorXd x = flat(inflated.deformed);
+  double pressure = inflated.pressure_kpa * MPA_PER_KPA;
+  if (!m_solver.solve_volume(x, pressure, m_target_volume, m_settings).converged) return false;
+  m_x = flat(rigid_align_to(unflatten(x), m_target.vertices));
+  m_pressure = pressure;
+  m_best_error = std::numeric_limits<double>::infinity();
+  return true;
 }
 
 bool DesignDriver::trial_start_in_range(const Eigen::VectorXd& rest, const Eigen::VectorXd& x, double pressure) {

@@ -78,6 +78,10 @@ class DesignDriver {
   /// non-finite or beyond 1e10 times the force scale (PREDICTOR_RESIDUAL_LIMIT: a predictor carried past the
   /// linear range, where a stiffening rubber's forces explode).
   bool trial_start_in_range(const Eigen::VectorXd& rest, const Eigen::VectorXd& x, double pressure);
+  /// Inflates `rest` from rest as `balloon simulate` does; where that reaches another shape than the
+  /// current equilibrium (farther from it than the current error), the design goes on from that shape,
+  /// placed on the target, and forgets the best design seen. True when it switched.
+  bool take_shape_from_rest(const Eigen::VectorXd& rest);
   /// Whether the last Newton solve stopped on the cancel token or the deadline.
   bool stopped() const;
 
@@ -109,6 +113,9 @@ class DesignDriver {
   /// Where that needed the sheet's bending stiffness, the design keeps it on (adjoint method; listed as
   /// the active term "sheet_bending").
   bool inflate_start_to_target_volume(const Eigen::VectorXd& rest, DesignResult& result);
+  /// Volume control from `rest` to the target's volume with the model's material and thickness, to the
+  /// design's tolerance, within the design's deadline: what the start and take_shape_from_rest share.
+  InflationOptions inflation_from_rest(const Eigen::VectorXd& rest) const;
   /// The sheet's bending on or off in the model, and the solver's pattern to match.
   void set_bending(bool on);
 

@@ -182,6 +182,21 @@ v1::DesignReport design_report(const jobs::DesignInput& input, const jobs::Desig
     }
   }
 
+  if (const std::optional<RestInflationCheck>& check = result.from_rest) {
+    v1::RestInflationCheck* out = report.mutable_from_rest();
+    out->set_converged(check->converged);
+    out->set_stop_reason(inflation_stop_word(check->stop));
+    out->set_message(check->message);
+    if (check->avg_error_mm) out->set_avg_error_mm(*check->avg_error_mm);
+    if (check->max_error_mm) out->set_max_error_mm(*check->max_error_mm);
+    if (check->avg_error_rel) out->set_avg_error_rel(*check->avg_error_rel);
+    if (check->pressure_kpa) out->set_pressure_kpa(*check->pressure_kpa);
+    out->set_unstable_modes(check->unstable_modes);
+    if (check->deviation_mm) out->set_deviation_mm(*check->deviation_mm);
+    out->set_another_shape(check->another_shape);
+    out->set_time_s(check->time_s);
+  }
+
   v1::ConvergenceLog* log = report.mutable_convergence();
   for (const ConvergenceSample& sample : result.log) {
     log->add_time_s(sample.time_s);

@@ -61,6 +61,20 @@ TEST(ReportJson, AnErrorNeverComputedIsNullAndAnInapplicableCountIsAbsent) {
   EXPECT_EQ(json.find('\n'), json.size() - 1) << "one line";
 }
 
+TEST(ReportJson, TheCheckFromRestIsAbsentWithoutADesignAndNullWhereItDidNotFinish) {
+  EXPECT_EQ(report_json(v1::DesignReport()).find("from_rest"), std::string::npos) << "no check without a design";
+  v1::DesignReport report = design_with_errors();
+  v1::RestInflationCheck* check = report.mutable_from_rest();
+  check->set_stop_reason("time_limit");
+  check->set_message("inflated from rest, as balloon simulate does, it did not reach the design's volume: time limit");
+  const std::string json = report_json(report);
+  for (const char* key : {"avg_error_mm", "max_error_mm", "avg_error_rel", "pressure_kpa", "deviation_mm"})
+    EXPECT_NE(json.find(std::string("\"") + key + "\":null", json.find("\"from_rest\"")), std::string::npos)
+        << key << " in " << json;
+  EXPECT_NE(json.find("\"from_rest\":{\"converged\":false,\"stop_reason\":\"time_limit\","), std::string::npos) << json;
+  EXPECT_NE(json.find("\"another_shape\":false"), std::string::npos) << json;
+}
+
 TEST(ReportJson, ComputedValuesAndResumptionAreWritten) {
   v1::DesignReport report = design_with_errors();
   report.set_resumed_from_iteration(17);

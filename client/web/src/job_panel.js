@@ -281,8 +281,9 @@ export class JobPanel {
 
   take_progress(progress) {
     this.show_readouts(progress);
-    // The tolerance phase after the design re-inflates perturbed copies; its errors are not the design's.
-    if (progress.phase !== 'tolerance') this.m_plot.add_point(progress.elapsed_s, progress.avg_error_mm);
+    // After the design, the check inflates its rest shape from rest and the tolerance phase re-inflates
+    // perturbed copies; neither has the design's errors.
+    if (progress.phase !== 'tolerance' && progress.phase !== 'check') this.m_plot.add_point(progress.elapsed_s, progress.avg_error_mm);
   }
 
   /** The readouts for one Progress message. */
@@ -450,6 +451,12 @@ export class JobPanel {
     if (report.pressure_kpa != null)
       lines.push(`Inflate to ${format_number(report.pressure_kpa, 4)} kPa; volume ratio ${format_number(report.volume_ratio, 4)}; ` +
         `${report.vertices ?? '?'} vertices; ${report.material_name || report.material || ''}, ${format_number(report.thickness_mm, 3)} mm thick.`);
+    const from_rest = report.from_rest;
+    if (from_rest && from_rest.avg_error_mm != null)
+      lines.push(`Inflated from rest, as a maker inflates it: ${from_rest.another_shape ? 'ANOTHER SHAPE than the design\'s' : 'the design\'s shape'}, ` +
+        `average ${format_error_mm(from_rest.avg_error_mm)} mm at ${format_number(from_rest.pressure_kpa, 4)} kPa ` +
+        `(${format_error_mm(from_rest.deviation_mm)} mm from the design's shape on average).`);
+    else if (from_rest && from_rest.message) lines.push(from_rest.message);
     if (report.mold_problem) lines.push(`No mold: ${report.mold_problem}`);
     if (job.kind === 'JOB_KIND_CURVE') lines.push(...curve_summary_lines(report));
     summary.replaceChildren(...lines.map((line) => {

@@ -31,6 +31,14 @@ TEST(BalloonDesign, RecoversTheBalloonOfAnInflatedEllipsoid) {
   EXPECT_LT(design.avg_error_rel.value(), 1e-3) << design.message << " after " << design.iterations << " iterations";
   EXPECT_NEAR(design.volume_ratio.value(), 6.0, 1e-3);
   EXPECT_TRUE(design.converged) << design_stop_name(design.stop) << ": " << design.message;
+  // Inflated from rest as balloon simulate does, the designed silicone balloon (no pressure maximum
+  // passed: one equilibrium per volume) takes the design's shape and its error.
+  ASSERT_TRUE(design.from_rest) << "a design is checked from rest";
+  ASSERT_TRUE(design.from_rest->converged) << design.from_rest->message;
+  EXPECT_FALSE(design.from_rest->another_shape) << design.from_rest->message;
+  EXPECT_LT(design.from_rest->deviation_mm.value(), 1e-3 * design.bbox_diag_mm);
+  EXPECT_NEAR(design.from_rest->avg_error_mm.value(), design.avg_error_mm.value(), 1e-3 * design.bbox_diag_mm);
+  EXPECT_NEAR(design.from_rest->pressure_kpa.value(), design.pressure_kpa.value(), 1e-3 * design.pressure_kpa.value());
   std::printf("ellipsoid design: %d iterations, %.2f s, avg error %.3g mm (baseline %.3g mm), %s\n", design.iterations,
               design.time_s, design.avg_error_mm.value(), design.baseline_avg_error_mm.value(), design.message.c_str());
 }
@@ -200,6 +208,7 @@ TEST(BalloonDesign, BadOptionsAreReportedNotThrown) {
   EXPECT_NE(design.message.find("thickness"), std::string::npos);
   EXPECT_FALSE(design.avg_error_mm.has_value());
   EXPECT_FALSE(design.baseline_avg_error_mm.has_value());
+  EXPECT_FALSE(design.from_rest.has_value()) << "no design, so nothing to inflate from rest";
 }
 
 TEST(BalloonDesign, ADesignStoppedBeforeItsStartInflatedHasNoErrors) {
@@ -221,6 +230,7 @@ TEST(BalloonDesign, ADesignStoppedBeforeItsStartInflatedHasNoErrors) {
   EXPECT_FALSE(design.volume_ratio.has_value());
   EXPECT_FALSE(design.distance_energy.has_value());
   EXPECT_FALSE(design.residual_norm.has_value());
+  EXPECT_FALSE(design.from_rest.has_value());
 }
 
 TEST(BalloonDesign, AStartThatAlreadyMatchesIsMatchedNotStalled) {

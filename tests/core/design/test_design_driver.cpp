@@ -1,5 +1,5 @@
-// The design driver's steps that the optimizers share: switching the sheet's bending on mid-design, judging a
-// trial's start, and going back to the best design.
+// The design driver's steps that the optimizers share: switching the sheet's bending on mid-design, taking
+// the shape reached from rest, judging a trial's start, and going back to the best design.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -60,6 +60,30 @@ TEST(DesignDriver, SwitchingBendingOnKeepsAnEquilibriumAndListsTheTerm) {
 
   EXPECT_FALSE(driver.switch_bending_on(rest, result)) << "once only";
   EXPECT_EQ(std::count(result.active_terms.begin(), result.active_terms.end(), "sheet_bending"), 1);
+}
+
+TEST(DesignDriver, TheShapeReachedFromRestLeavesTheDesignsAloneAndReplacesAnotherOne) {
+  // Past a pressure maximum the design can follow a branch that inflating its rest shape from rest does
+  // not reach; the driver then goes on from the shape that inflation reaches.
+  EllipsoidDesign design(DesignMethod::Adjoint);
+  DesignDriver& driver = design.driver;
+  const Eigen::VectorXd& rest = design.start;
+  ASSERT_TRUE(design.inflate_start()) << design.result.message;
+  const Eigen::VectorXd start_x = driver.x();
+  const double start_pressure = driver.pressure();
+
+  // Silicone here has one equilibrium per volume: from rest it reaches the driver's own shape.
+  EXPECT_FALSE(driver.take_shape_from_rest(rest));
+  EXPECT_EQ(driver.x(), start_x);
+
+  // On the target itself (no error, but no equilibrium of this rest shape) the shape reached from rest is
+  // another one: the start's inflation again, placed on the target, and the best design seen is forgotten.
+  driver.x() = flat(design.target.vertices);
+  ASSERT_TRUE(driver.take_shape_from_rest(rest));
+  EXPECT_LT((driver.x() - start_x).cwiseAbs().maxCoeff(), 1e-3);  // mm, on a 65 mm balloon
+  EXPECT_NEAR(driver.pressure(), start_pressure, 1e-6 * start_pressure);
+  Eigen::VectorXd best = rest;
+  EXPECT_FALSE(driver.restore_best_equilibrium(best)) << "the best design seen belonged to the other shape";
 }
 
 TEST(DesignDriver, ATrialStartFarPastTheLinearRangeIsNotWorthNewtonSteps) {
