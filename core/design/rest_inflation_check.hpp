@@ -3,7 +3,7 @@
 /// its rest shape, along the forward solver's volume path, to the design's volume ratio. Past a pressure
 /// maximum a rubber has several equilibria at one volume, and the design follows its own branch as it
 /// reshapes the rest shape at a fixed volume, so the shape reached from rest can be another one (latex
-/// spot and bear at x8: 7-9% of the diagonal away from the design's, session 56). This says which.
+/// spot and bear at x8: 6-8 mm, 4-6% of the diagonal, from the design's, session 56). This says which.
 #include <optional>
 #include <string>
 
@@ -25,7 +25,7 @@ struct RestInflationCheck {
   /// surface; none unless converged.
   std::optional<double> deviation_mm;
   /// It is not the design's shape: the deviation exceeds both the design's own average error and
-  /// ANOTHER_SHAPE_MIN_REL of the diagonal, so the design's error is not what the maker gets.
+  /// ANOTHER_SHAPE_MIN_REL (0.5%) of the diagonal, so the design's error is not what the maker gets.
   bool another_shape = false;
   double time_s = 0.0;              ///< wall time of the check (s)
 };
@@ -34,8 +34,10 @@ struct RestInflationCheck {
 /// about 20 s (the knot, Mooney-Rivlin x8).
 constexpr double REST_INFLATION_CHECK_TIME_LIMIT_S = 60.0;
 
-/// A deviation below this fraction of the target's diagonal is the same shape, however close the design.
-constexpr double ANOTHER_SHAPE_MIN_REL = 1e-3;
+/// A deviation below this fraction of the target's diagonal is the same shape, however close the design:
+/// 0.75 mm on a 150 mm balloon, about what a brushed layer of silicone varies by. (At 0.1%, the README's
+/// spot design, 0.087 mm from its target, was called another shape 0.11 mm from its own.)
+constexpr double ANOTHER_SHAPE_MIN_REL = 5e-3;
 
 /// Inflates `rest` (the design's rest shape on the target's connectivity, mm) with `options` (material,
 /// thickness, nozzle, volume ratio, time limit and cancel token as the design had them; the forward
