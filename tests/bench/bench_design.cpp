@@ -129,6 +129,22 @@ std::string from_rest_summary(const std::string& material, const std::string& me
   return buf;
 }
 
+/// One table row per material and method that ran, made by `row` (target_summary, from_rest_summary) from
+/// that group's runs.
+template <typename Row>
+std::string rows_by_material_and_method(const std::vector<Run>& runs, const std::vector<std::string>& materials,
+                                        const std::vector<balloon::DesignMethod>& methods, Row row) {
+  std::string rows;
+  for (const std::string& material : materials)
+    for (const balloon::DesignMethod method : methods) {
+      std::vector<const Run*> group;
+      for (const Run& run : runs)
+        if (run.material == material && run.result.method == method) group.push_back(&run);
+      if (!group.empty()) rows += row(material, balloon::design_method_name(method), group);
+    }
+  return rows;
+}
+
 /// Average error (% of the bbox diagonal, log scale) against time (s), one polyline per method.
 std::string svg_plot(const std::string& title, const std::vector<const Run*>& runs) {
   balloon::bench::PlotPanel panel;
@@ -345,26 +361,14 @@ int main(int argc, char** argv) {
       "| material | method | shapes | failed starts | <= 1% and >= 3x | >= 2x | median error | median time | max time "
       "| median time to <= 1% and >= 3x | max time to it |\n"
       "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-  for (const std::string& material : material_specs)
-    for (const auto method : methods) {
-      std::vector<const Run*> group;
-      for (const Run& run : runs)
-        if (run.material == material && run.result.method == method) group.push_back(&run);
-      if (!group.empty()) table += target_summary(material, balloon::design_method_name(method), group);
-    }
+  table += rows_by_material_and_method(runs, material_specs, methods, target_summary);
   std::printf("\ntargets (issue 10): no failed start; <= 1%% and >= 3x on >= 90%% of shapes; >= 2x on all; median <= 0.7%%; "
               "a design within 30 s, median 10 s (here: the time each first met <= 1%% and >= 3x, from its log)\n%s",
               table.c_str());
   std::string from_rest_table =
       "| material | method | shapes | another shape from rest | <= 1% and >= 3x from rest | >= 2x from rest | median error from rest |\n"
       "|---|---|---:|---:|---:|---:|---:|\n";
-  for (const std::string& material : material_specs)
-    for (const auto method : methods) {
-      std::vector<const Run*> group;
-      for (const Run& run : runs)
-        if (run.material == material && run.result.method == method) group.push_back(&run);
-      if (!group.empty()) from_rest_table += from_rest_summary(material, balloon::design_method_name(method), group);
-    }
+  from_rest_table += rows_by_material_and_method(runs, material_specs, methods, from_rest_summary);
   std::printf("\nthe same rest shapes inflated from rest as balloon simulate does (what a maker gets):\n%s",
               from_rest_table.c_str());
   table += "\n" + from_rest_table;
