@@ -1,13 +1,12 @@
 #include "design/design_driver.hpp"
 
-#include "design/rest_inflation_check.hpp"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
+#include "design/rest_inflation_check.hpp"
 #include "mesh/mesh_geometry.hpp"
 #include "solve/inflation.hpp"
 #include "solve/rigid_modes.hpp"
@@ -267,7 +266,7 @@ bool DesignDriver::take_shape_from_rest(const Eigen::VectorXd& rest) {
   if (std::getenv("BALLOON_DEBUG_DESIGN"))
     std::fprintf(stderr, "  from rest: %.3g mm from the design's shape (its error %.3g mm), %.4g kPa against %.4g kPa\n",
                  deviation, error, inflated.pressure_kpa, m_pressure / MPA_PER_KPA);
-  if (deviation <= std::max(error, ANOTHER_SHAPE_MIN_REL * m_objective.surface().bbox_diagonal_mm())) return false;
+  if (!is_another_shape(deviation, error, m_objective.surface().bbox_diagonal_mm())) return false;
   if (inflated.bending && !m_model.bending()) set_bending(true);
   Eigen::VectorXd x = flat(inflated.deformed);
   double pressure = inflated.pressure_kpa * MPA_PER_KPA;

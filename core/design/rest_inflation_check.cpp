@@ -16,6 +16,10 @@ std::string millimetres(double value_mm) {
 
 }  // namespace
 
+bool is_another_shape(double deviation_mm, double design_avg_error_mm, double bbox_diag_mm) {
+  return deviation_mm > std::max(design_avg_error_mm, ANOTHER_SHAPE_MIN_REL * bbox_diag_mm);
+}
+
 RestInflationCheck check_inflation_from_rest(const TriMesh& rest, const InflationOptions& options,
                                              const Positions& design_inflated, double design_avg_error_mm,
                                              const SurfaceDistance& target, const Positions& target_vertices) {
@@ -38,8 +42,7 @@ RestInflationCheck check_inflation_from_rest(const TriMesh& rest, const Inflatio
   check.unstable_modes = inflated.unstable_modes;
   const SurfaceDistance design_surface(TriMesh{design_inflated, rest.faces});
   check.deviation_mm = design_surface.aligned_stats(inflated.deformed, design_inflated).avg_mm;
-  check.another_shape =
-      *check.deviation_mm > std::max(design_avg_error_mm, ANOTHER_SHAPE_MIN_REL * error.bbox_diag_mm);
+  check.another_shape = is_another_shape(*check.deviation_mm, design_avg_error_mm, error.bbox_diag_mm);
   const std::string reached = "avg error " + millimetres(error.avg_mm) + " (" +
                               millimetres(*check.deviation_mm) + " from the design's shape on average)";
   check.message = check.another_shape

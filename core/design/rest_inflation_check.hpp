@@ -39,6 +39,10 @@ constexpr double REST_INFLATION_CHECK_TIME_LIMIT_S = 60.0;
 /// spot design, 0.087 mm from its target, was called another shape 0.11 mm from its own.)
 constexpr double ANOTHER_SHAPE_MIN_REL = 5e-3;
 
+/// Whether a shape `deviation_mm` from the design's inflated shape is another one: farther than the
+/// design's own average error and than ANOTHER_SHAPE_MIN_REL of the target's diagonal.
+bool is_another_shape(double deviation_mm, double design_avg_error_mm, double bbox_diag_mm);
+
 /// Inflates `rest` (the design's rest shape on the target's connectivity, mm) with `options` (material,
 /// thickness, nozzle, volume ratio, time limit and cancel token as the design had them; the forward
 /// solver's own path settings) and compares the result with `design_inflated` (the design's inflated
