@@ -7,7 +7,9 @@
 #include <condition_variable>
 #include <csignal>
 #include <cstdio>
+#include <map>
 #include <mutex>
+#include <string>
 #include <thread>
 
 #include "cli_output.hpp"
@@ -116,7 +118,15 @@ ProgressPrinter::~ProgressPrinter() {
 void ProgressPrinter::operator()(const balloon::v1::JobEvent& event) {
   if (!m_enabled) return;
   char line[256];
-  if (event.has_progress()) {
+  // The phases after a design that carry no pressure or residual of their own, by what they do.
+  static const std::map<std::string, std::string> quiet_phases = {
+      {"check", "inflating the designed rest shape from rest, as balloon simulate does"},
+      {"tolerance", "inflating copies of the design with thickness errors"}};
+  const auto quiet = event.has_progress() ? quiet_phases.find(event.progress().phase()) : quiet_phases.end();
+  if (quiet != quiet_phases.end()) {
+    std::snprintf(line, sizeof(line), "%s [%6.2f s] %s", event.job_id().c_str(), event.progress().elapsed_s(),
+                  quiet->second.c_str());
+  } else if (event.has_progress()) {
     const auto& p = event.progress();
     int n = std::snprintf(line, sizeof(line), "%s [%6.2f s] %s %d  p=%.4g kPa  residual %.2e N", event.job_id().c_str(),
                           p.elapsed_s(), p.phase().c_str(), p.iteration(), p.pressure_kpa(), p.residual_norm());

@@ -90,12 +90,13 @@ void add_rest_inflation_check(const TriMesh& target, const DesignOptions& option
     event.elapsed_s = result.time_s;
     options.progress(event);
   }
-  InflationOptions inflation;  // the forward solver's own path settings, as balloon simulate uses them
+  // The forward solver's own path settings, as balloon simulate uses them, on a free balloon as the
+  // design's (a nozzle holds rest vertices in the design, not the inflated sheet).
+  InflationOptions inflation;
   inflation.material = options.material;
   inflation.thickness_mm = options.thickness_mm;
   inflation.control = InflationControl::VolumeRatio;
   inflation.volume_ratio = *result.volume_ratio;
-  inflation.fixed_vertices = options.nozzle_vertices;
   inflation.max_time_s = REST_INFLATION_CHECK_TIME_LIMIT_S;
   inflation.cancel = options.cancel;
   result.from_rest = check_inflation_from_rest(result.rest, inflation, result.inflated, *result.avg_error_mm,

@@ -256,9 +256,7 @@ bool DesignDriver::equilibrium(const Eigen::VectorXd& rest, Eigen::VectorXd& x, 
 bool DesignDriver::take_shape_from_rest(const Eigen::VectorXd& rest) {
   m_model.set_rest_positions(unflatten(rest));
   // The forward solver's own path settings, as balloon simulate uses them (the start keeps the design's).
-  InflationOptions inflation = inflation_from_rest(rest);
-  inflation.fixed_vertices = m_options.nozzle_vertices;
-  const InflationResult inflated = inflate(TriMesh{unflatten(rest), m_model.faces()}, inflation);
+  const InflationResult inflated = inflate(TriMesh{unflatten(rest), m_model.faces()}, inflation_from_rest(rest));
   if (!inflated.converged) return false;
   const Positions current = unflatten(m_x);
   const double deviation = SurfaceDistance(TriMesh{current, m_model.faces()}).aligned_stats(inflated.deformed, current).avg_mm;

@@ -44,8 +44,8 @@ constexpr double ANOTHER_SHAPE_MIN_REL = 5e-3;
 bool is_another_shape(double deviation_mm, double design_avg_error_mm, double bbox_diag_mm);
 
 /// Inflates `rest` (the design's rest shape on the target's connectivity, mm) with `options` (material,
-/// thickness, nozzle, volume ratio, time limit and cancel token as the design had them; the forward
-/// solver's own path settings) and compares the result with `design_inflated` (the design's inflated
+/// thickness, volume ratio, time limit and cancel token as the design had them; a free balloon, as the
+/// design's, whose nozzle holds rest vertices only; the forward solver's own path settings) and compares the result with `design_inflated` (the design's inflated
 /// shape, #V by 3, mm) and with `target` (the surface the design's error is measured on), whose average
 /// error for the design was `design_avg_error_mm`.
 RestInflationCheck check_inflation_from_rest(const TriMesh& rest, const InflationOptions& options,
