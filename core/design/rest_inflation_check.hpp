@@ -45,9 +45,10 @@ bool is_another_shape(double deviation_mm, double design_avg_error_mm, double bb
 
 /// Inflates `rest` (the design's rest shape on the target's connectivity, mm) with `options` (material,
 /// thickness, volume ratio, time limit and cancel token as the design had them; a free balloon, as the
-/// design's, whose nozzle holds rest vertices only; the forward solver's own path settings) and compares the result with `design_inflated` (the design's inflated
-/// shape, #V by 3, mm) and with `target` (the surface the design's error is measured on), whose average
-/// error for the design was `design_avg_error_mm`.
+/// design's, whose nozzle holds rest vertices only; the forward solver's own path settings) and compares
+/// the result with `design_inflated` (the design's inflated shape, #V by 3, mm) and with `target` (the
+/// surface the design's error is measured on), whose average error for the design was
+/// `design_avg_error_mm`.
 RestInflationCheck check_inflation_from_rest(const TriMesh& rest, const InflationOptions& options,
                                              const Positions& design_inflated, double design_avg_error_mm,
                                              const SurfaceDistance& target, const Positions& target_vertices);
