@@ -259,7 +259,7 @@ bool DesignDriver::take_shape_from_rest(const Eigen::VectorXd& rest) {
   const InflationResult inflated = inflate(TriMesh{unflatten(rest), m_model.faces()}, inflation_from_rest(rest));
   if (!inflated.converged) return false;
   const Positions current = unflatten(m_x);
-  const double deviation = SurfaceDistance(TriMesh{current, m_model.faces()}).aligned_stats(inflated.deformed, current).avg_mm;
+  const double deviation = deviation_from_design_mm(inflated.deformed, current, m_model.faces());
   const double error = m_objective.surface().aligned_stats(current, m_target.vertices).avg_mm;
   if (std::getenv("BALLOON_DEBUG_DESIGN"))
     std::fprintf(stderr, "  from rest: %.3g mm from the design's shape (its error %.3g mm), %.4g kPa against %.4g kPa\n",

@@ -16,6 +16,10 @@ std::string millimetres(double value_mm) {
 
 }  // namespace
 
+double deviation_from_design_mm(const Positions& shape, const Positions& design_inflated, const Faces& faces) {
+  return SurfaceDistance(TriMesh{design_inflated, faces}).aligned_stats(shape, design_inflated).avg_mm;
+}
+
 bool is_another_shape(double deviation_mm, double design_avg_error_mm, double bbox_diag_mm) {
   return deviation_mm > std::max(design_avg_error_mm, ANOTHER_SHAPE_MIN_REL * bbox_diag_mm);
 }
@@ -40,8 +44,7 @@ RestInflationCheck check_inflation_from_rest(const TriMesh& rest, const Inflatio
   check.avg_error_rel = error.avg_rel;
   check.pressure_kpa = inflated.pressure_kpa;
   check.unstable_modes = inflated.unstable_modes;
-  const SurfaceDistance design_surface(TriMesh{design_inflated, rest.faces});
-  check.deviation_mm = design_surface.aligned_stats(inflated.deformed, design_inflated).avg_mm;
+  check.deviation_mm = deviation_from_design_mm(inflated.deformed, design_inflated, rest.faces);
   check.another_shape = is_another_shape(*check.deviation_mm, design_avg_error_mm, error.bbox_diag_mm);
   const std::string reached = "avg error " + millimetres(error.avg_mm) + " (" +
                               millimetres(*check.deviation_mm) + " from the design's shape on average)";

@@ -39,6 +39,10 @@ constexpr double REST_INFLATION_CHECK_TIME_LIMIT_S = 60.0;
 /// spot design, 0.087 mm from its target, was called another shape 0.11 mm from its own.)
 constexpr double ANOTHER_SHAPE_MIN_REL = 5e-3;
 
+/// Mean distance (mm) of `shape`'s vertices, rigidly aligned on `design_inflated` (same connectivity
+/// `faces`), to that shape's surface: how far a shape reached from rest is from the design's.
+double deviation_from_design_mm(const Positions& shape, const Positions& design_inflated, const Faces& faces);
+
 /// Whether a shape `deviation_mm` from the design's inflated shape is another one: farther than the
 /// design's own average error and than ANOTHER_SHAPE_MIN_REL of the target's diagonal.
 bool is_another_shape(double deviation_mm, double design_avg_error_mm, double bbox_diag_mm);
