@@ -319,10 +319,10 @@ int main(int argc, char** argv) {
         if (const std::optional<balloon::RestInflationCheck>& check = r.from_rest) {
           if (check->converged)
             std::printf("%-22s   from rest (as balloon simulate): %s, avg %.4g mm (%.3f%%), %.1fx, %.3g mm from the design's "
-                        "shape, %.4g kPa, check %.1f s\n",
+                        "shape, %.4g kPa, %d unstable modes, check %.1f s\n",
                         "", check->another_shape ? "ANOTHER SHAPE" : "the design's shape", *check->avg_error_mm,
                         100.0 * *check->avg_error_rel, shown(r.baseline_avg_error_mm) / *check->avg_error_mm,
-                        *check->deviation_mm, *check->pressure_kpa, check->time_s);
+                        *check->deviation_mm, *check->pressure_kpa, check->unstable_modes, check->time_s);
           else
             std::printf("%-22s   from rest (as balloon simulate): %s (%.1f s)\n", "", check->message.c_str(), check->time_s);
         }

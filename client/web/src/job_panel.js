@@ -455,7 +455,9 @@ export class JobPanel {
     if (from_rest && from_rest.avg_error_mm != null)
       lines.push(`Inflated from rest, as a maker inflates it: ${from_rest.another_shape ? 'ANOTHER SHAPE than the design\'s' : 'the design\'s shape'}, ` +
         `average ${format_error_mm(from_rest.avg_error_mm)} mm at ${format_number(from_rest.pressure_kpa, 4)} kPa ` +
-        `(${format_error_mm(from_rest.deviation_mm)} mm from the design's shape on average).`);
+        `(${format_error_mm(from_rest.deviation_mm)} mm from the design's shape on average)` +
+        (from_rest.unstable_modes > 0 ? `; there it is a saddle under volume control (${from_rest.unstable_modes} unstable ` +
+          'directions: wrinkling or symmetry breaking), and the real balloon may take another shape.' : '.'));
     else if (from_rest && from_rest.message) lines.push(from_rest.message);
     if (report.mold_problem) lines.push(`No mold: ${report.mold_problem}`);
     if (job.kind === 'JOB_KIND_CURVE') lines.push(...curve_summary_lines(report));
