@@ -25,6 +25,11 @@ constexpr double MAX_ROUNDING_FLOOR = 1e-5;
 /// With the residual at its floor, the volume counts as met within this fraction of the target (a sum of
 /// #F terms, so about a thousand roundings of it), should the tolerance ask for more.
 constexpr double VOLUME_ROUNDING = 1e-12;
+/// Close to a solution (residual below NEAR_SADDLE_RESIDUAL of the force scale) whose exact stiffness
+/// has unstable modes, SQP steps whose residual has not halved in SADDLE_CREEP_STEPS steps are creeping,
+/// and the next ones use the exact Hessian, shifted (sqp_step).
+constexpr double NEAR_SADDLE_RESIDUAL = 1e-2;
+constexpr int SADDLE_CREEP_STEPS = 4;
 
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -267,7 +272,7 @@ NewtonReport EquilibriumSolver::newton_volume(Eigen::VectorXd& x, double& pressu
     const double value = std::pow(rn / force_tolerance, 2) + std::pow(c / volume_tolerance, 2);
     return std::isfinite(value) ? value : std::numeric_limits<double>::infinity();
   };
-  std::vector<double> scaled_residuals;  // |r| / force tolerance per iteration, for settings.abandon_slow
+  std::vector<double> scaled_residuals;  // |r| / force tolerance per iteration
   double previous_residual = std::numeric_limits<double>::infinity();
   double residual_at_exact_try = std::numeric_limits<double>::infinity();  // N, when the exact step was last tried
   for (report.iterations = 0;; ++report.iterations) {
@@ -299,9 +304,9 @@ NewtonReport EquilibriumSolver::newton_volume(Eigen::VectorXd& x, double& pressu
     }
     if (settings.on_iteration) settings.on_iteration(report.iterations, report.residual_norm, pressure_mpa);
     if (should_stop(settings, report)) return report;
+    scaled_residuals.push_back(report.residual_norm / force_tolerance);
+    const size_t last = scaled_residuals.size() - 1;
     if (settings.abandon_slow || settings.stagnation_tolerance_factor > 0.0) {
-      scaled_residuals.push_back(report.residual_norm / force_tolerance);
-      const size_t last = scaled_residuals.size() - 1;
       if (last >= 4 && scaled_residuals[last] > 0.5 * scaled_residuals[last - 2]) {
         if (scaled_residuals[last] <= settings.stagnation_tolerance_factor && std::abs(c) <= volume_tolerance) {
           report.unstable_modes = m_last_unstable_modes;
@@ -380,7 +385,17 @@ NewtonReport EquilibriumSolver::newton_volume(Eigen::VectorXd& x, double& pressu
 
     // Robust path (wrinkling, snap-through, past limit points, far from a solution): an SQP step on a
     // positive definite model of the Hessian, which descends towards a constrained minimum of W.
-    if (!sqp_step(x, pressure_mpa, target_volume, v, r, c, settings)) {
+    // Near a saddle (the exact step towards it refused) the projected blocks are far stiffer than the
+    // sheet along its soft directions, and their unshifted steps can creep: the latex cube's designed rest
+    // shape sat at 1e-4 N (2,000 tolerances) for 55 steps at a time, 1,805 Newton steps and 161 s for its
+    // path to x8. There the exact Hessian, shifted to a constrained minimum's inertia, is the better model
+    // (402 steps, 29 s; the quick bench 2,449 -> 2,238 Newton steps). Used at once near every saddle, it
+    // cost more than it saved (knot with latex x27: 73 -> 121 Newton steps).
+    const bool creeping_near_saddle =
+        settings.exact_hessian_near_saddles && m_last_unstable_modes > 0 &&
+        report.residual_norm < NEAR_SADDLE_RESIDUAL * scale && last >= SADDLE_CREEP_STEPS &&
+        scaled_residuals[last] > 0.5 * scaled_residuals[last - SADDLE_CREEP_STEPS];
+    if (!sqp_step(x, pressure_mpa, target_volume, v, r, c, settings, creeping_near_saddle)) {
       report.stop = NewtonStop::LineSearchFailed;
       report.message = "line search failed";
       return report;
@@ -426,8 +441,9 @@ int EquilibriumSolver::kkt_negative_eigenvalues(const Eigen::VectorXd& v, const 
 }
 
 bool EquilibriumSolver::sqp_step(Eigen::VectorXd& x, double& pressure_mpa, double target_volume,
-                                 const Eigen::VectorXd& v, const Eigen::VectorXd& r, double c, const NewtonSettings& settings) {
-  m_model.assemble_hessian(x, pressure_mpa, m_assembly, true);
+                                 const Eigen::VectorXd& v, const Eigen::VectorXd& r, double c,
+                                 const NewtonSettings& settings, bool exact_hessian) {
+  m_model.assemble_hessian(x, pressure_mpa, m_assembly, !exact_hessian);
   const double base = std::max(1e-30, m_assembly.mean_abs_diagonal());
   // The model H (projected membrane blocks, exact pressure term) is used unshifted when the KKT matrix
   // [H v; v^T 0] has the inertia of a constrained minimum (H positive definite, or one negative

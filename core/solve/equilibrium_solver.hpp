@@ -101,6 +101,10 @@ struct NewtonSettings {
   /// the tolerance without converging (the design's latex knot: 13 exact steps between 1e-5 and 9e-5 N
   /// against 9.5e-6 N, the volume met to 1e-4 mm^3; nothing non-smooth in that model).
   double stagnation_tolerance_factor = 0.0;
+  /// Volume control: where SQP steps creep close to a saddle (see equilibrium_solver.cpp), the next ones
+  /// use the exact Hessian, shifted, as their model instead of the projected membrane blocks. The design's
+  /// trials turn it off (see DesignDriver::equilibrium).
+  bool exact_hessian_near_saddles = true;
   /// Called at every Newton iteration that goes on (not at the converged one) with the iteration's index
   /// within this solve, its residual norm (N) and pressure (MPa): the progress of a long solve.
   std::function<void(int iteration, double residual_norm, double pressure_mpa)> on_iteration;
@@ -172,10 +176,10 @@ class EquilibriumSolver {
   /// (Haynsworth: the inertia of K plus the sign of -v^T K^-1 v), given `solved` = solve_kkt(r, v).
   int kkt_negative_eigenvalues(const Eigen::VectorXd& v, const KktSolves& solved) const;
   /// One SQP step for volume control with a positive definite model of the Hessian (projected membrane
-  /// blocks plus a Levenberg shift), globalised on the augmented Lagrangian at the new multiplier.
-  /// `settings` gives shift_restart and shift_after_cut_short.
+  /// blocks, or with `exact_hessian` the exact one, plus a Levenberg shift), globalised on the augmented
+  /// Lagrangian at the new multiplier. `settings` gives shift_restart and shift_after_cut_short.
   bool sqp_step(Eigen::VectorXd& x, double& pressure_mpa, double target_volume, const Eigen::VectorXd& v,
-                const Eigen::VectorXd& r, double c, const NewtonSettings& settings);
+                const Eigen::VectorXd& r, double c, const NewtonSettings& settings, bool exact_hessian);
   /// KKT step of the factorized positive definite Hessian (model), line-searched on the augmented
   /// Lagrangian at the new multiplier or on a clear fall of the KKT residual. The number of step
   /// halvings the accepted step needed, or -1 if no step helped. `exact_model`: the factorization is
