@@ -76,4 +76,9 @@ std::string format(const char* pattern, double value) {
   return buffer;
 }
 
+std::string saddle_note(int unstable_modes) {
+  return "a saddle under volume control: " + std::to_string(unstable_modes) +
+         " unstable direction(s) (wrinkling or symmetry breaking; the real balloon may take another shape)";
+}
+
 }  // namespace balloon::cli

@@ -27,6 +27,10 @@ Result<bool> write_file_atomically(const std::string& path, const std::string& b
 /// One number through a printf pattern ("%.3f"): how the summaries print measured values.
 std::string format(const char* pattern, double value);
 
+/// What an equilibrium with `unstable_modes` (> 0) unstable directions under volume control means, for a
+/// summary's "stability" line: the simulate and design summaries say it alike.
+std::string saddle_note(int unstable_modes);
+
 /// A message as one line of protobuf JSON (proto field names, defaults printed): what --json prints.
 std::string message_to_json(const google::protobuf::Message& message);
 

@@ -196,8 +196,7 @@ std::string summary_from_report(const v1::DesignReport& report, const std::strin
     else
       out << check.message() << "\n";
     if (check.converged() && check.unstable_modes() > 0)
-      out << "  stability      from rest, a saddle under volume control: " << check.unstable_modes()
-          << " unstable direction(s) (wrinkling or symmetry breaking; the real balloon may take another shape)\n";
+      out << "  stability      from rest, " << saddle_note(check.unstable_modes()) << "\n";
   }
   if (report.has_tolerance() && report.tolerance().levels_size() > 0) {
     out << "  tolerance     ";

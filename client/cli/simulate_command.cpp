@@ -93,8 +93,7 @@ std::string summary_from_report(const v1::SimulateReport& report) {
       << " factorizations) in " << format("%.3f", report.time_s()) << " s\n";
   if (!report.message().empty()) out << "  " << report.message() << "\n";
   if (report.unstable_modes() > 0)
-    out << "  stability      a saddle under volume control: " << report.unstable_modes()
-        << " unstable direction(s) (wrinkling or symmetry breaking; the real balloon may take another shape)\n";
+    out << "  stability      " << saddle_note(report.unstable_modes()) << "\n";
   append_model_notes(out, report.bending(), report.flipped_cap_slivers());
   out << "  material       " << report.material();
   if (!report.material_name().empty()) out << " (" << report.material_name() << ")";
