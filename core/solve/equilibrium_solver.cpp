@@ -29,7 +29,7 @@ constexpr double VOLUME_ROUNDING = 1e-12;
 /// has unstable modes, SQP steps whose residual has not halved in SADDLE_CREEP_STEPS steps are creeping,
 /// and the next ones use the exact Hessian, shifted (sqp_step).
 constexpr double NEAR_SADDLE_RESIDUAL = 1e-2;
-constexpr int SADDLE_CREEP_STEPS = 4;
+constexpr size_t SADDLE_CREEP_STEPS = 4;
 
 double now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -306,8 +306,12 @@ NewtonReport EquilibriumSolver::newton_volume(Eigen::VectorXd& x, double& pressu
     if (should_stop(settings, report)) return report;
     scaled_residuals.push_back(report.residual_norm / force_tolerance);
     const size_t last = scaled_residuals.size() - 1;
+    // Creeping: the residual has not halved over the last `steps` steps.
+    auto not_halved_in = [&](size_t steps) {
+      return last >= steps && scaled_residuals[last] > 0.5 * scaled_residuals[last - steps];
+    };
     if (settings.abandon_slow || settings.stagnation_tolerance_factor > 0.0) {
-      if (last >= 4 && scaled_residuals[last] > 0.5 * scaled_residuals[last - 2]) {
+      if (last >= 4 && not_halved_in(2)) {
         if (scaled_residuals[last] <= settings.stagnation_tolerance_factor && std::abs(c) <= volume_tolerance) {
           report.unstable_modes = m_last_unstable_modes;
           report.converged = true;
@@ -393,8 +397,7 @@ NewtonReport EquilibriumSolver::newton_volume(Eigen::VectorXd& x, double& pressu
     // cost more than it saved (knot with latex x27: 73 -> 121 Newton steps).
     const bool creeping_near_saddle =
         settings.exact_hessian_near_saddles && m_last_unstable_modes > 0 &&
-        report.residual_norm < NEAR_SADDLE_RESIDUAL * scale && last >= SADDLE_CREEP_STEPS &&
-        scaled_residuals[last] > 0.5 * scaled_residuals[last - SADDLE_CREEP_STEPS];
+        report.residual_norm < NEAR_SADDLE_RESIDUAL * scale && not_halved_in(SADDLE_CREEP_STEPS);
     if (!sqp_step(x, pressure_mpa, target_volume, v, r, c, settings, creeping_near_saddle)) {
       report.stop = NewtonStop::LineSearchFailed;
       report.message = "line search failed";
