@@ -39,6 +39,8 @@ constexpr double OPTIMALITY_TOLERANCE = 1e-6;
 /// Gauss-Newton direction.
 constexpr int GAUSS_NEWTON_CG_ITERATIONS = 20;
 constexpr double GAUSS_NEWTON_CG_TOLERANCE = 1e-2;
+/// The largest move of any rest vertex in one design step, a fraction of the target's diagonal.
+constexpr double MAX_TRUST_RADIUS_REL = 0.02;
 
 /// A fraction as a short human string: 0.01 -> "1%", 1e-4 -> "1e-04".
 std::string format_fraction(double fraction) {
@@ -122,7 +124,7 @@ class ReducedSpaceDesign {
     int small_decreases = 0;
     double stall_objective = objective;         // objective at the last real improvement of either
     int stall_iteration = first_iteration - 1;
-    TrustRadius trust(0.02 * result.bbox_diag_mm);
+    TrustRadius trust(MAX_TRUST_RADIUS_REL * result.bbox_diag_mm);
     stop_with(result, DesignStop::IterationLimit, "iteration limit reached");
     for (int iteration = first_iteration; iteration <= m_options.max_iterations; ++iteration) {
       if (m_options.cancel && m_options.cancel->cancelled()) {
@@ -234,8 +236,11 @@ class ReducedSpaceDesign {
         break;
       }
       const double model_decrease = gauss_newton_model_decrease(t, slope);
-      trust.after_step(first_t, t, largest, model_decrease > 0.0 ? (objective - trial_objective) / model_decrease : 1.0,
-                       newton_like);
+      const double agreement = model_decrease > 0.0 ? (objective - trial_objective) / model_decrease : 1.0;
+      if (std::getenv("BALLOON_DEBUG_DESIGN"))
+        std::fprintf(stderr, "    step: gauss-newton %d, largest move %.3g mm at t = 1, radius %.3g mm, agreement %.3g\n",
+                     newton_like ? 1 : 0, largest, trust.radius(), agreement);
+      trust.after_step(first_t, t, largest, agreement, newton_like);
       const Eigen::VectorXd step = trial_rest - rest;
       rest = trial_rest;
       m_x = trial_x;
@@ -290,6 +295,9 @@ class ReducedSpaceDesign {
         bool switched = false;
         if (m_sensitivity.volume_per_pressure() < 0.0 && m_driver.take_shape_from_rest(rest)) {
           switched = true;
+          // What the radius learned on the branch left behind says nothing about this one: shrunk there
+          // (latex bear: seven halvings in one iteration), it took eight iterations to grow back.
+          trust = TrustRadius(MAX_TRUST_RADIUS_REL * result.bbox_diag_mm);
           m_objective.realign(m_x);
           const SurfaceDistanceStats reached = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
           m_driver.remember_if_best(rest, reached.avg_mm);

@@ -20,7 +20,8 @@ class TrustRadius {
   /// After an accepted step t of a direction whose largest vertex move is `largest_mm`, first tried at
   /// `first_t` (the radius' cut): cut k times, the radius shrinks by 2^k (t / first_t); uncut, a
   /// Gauss-Newton step whose decrease was under a quarter of its model's (`agreement`) halves the move
-  /// it made, one over three quarters doubles the radius (up to the largest), and between them it stays.
+  /// it made (but shrinks the radius at most fourfold), one over three quarters doubles the radius (up
+  /// to the largest), and between them it stays.
   /// Steps that are not Gauss-Newton steps (L-BFGS, steepest descent) have no model to agree with: uncut,
   /// they double it.
   void after_step(double first_t, double t, double largest_mm, double agreement, bool gauss_newton);

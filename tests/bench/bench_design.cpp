@@ -167,6 +167,8 @@ int main(int argc, char** argv) {
   std::string data_dir = BALLOON_TEST_DATA_DIR;
   int resolution = 0;
   double max_time_s = 60.0;
+  // With a cap on iterations and a generous time, two builds compare step for step, whatever the load.
+  int max_iterations = balloon::DesignOptions{}.max_iterations;
   bool quick = false;
   bool corpus = false;
   double volume_ratio = 8.0;
@@ -193,6 +195,8 @@ int main(int argc, char** argv) {
       resolution = std::atoi(argv[++i]);
     } else if (arg == "--max-time" && i + 1 < argc) {
       max_time_s = std::atof(argv[++i]);
+    } else if (arg == "--max-iterations" && i + 1 < argc) {
+      max_iterations = std::atoi(argv[++i]);
     } else if (arg == "--method" && i + 1 < argc) {
       const auto method = balloon::parse_design_method(argv[++i]);
       if (!method) {
@@ -215,7 +219,7 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: bench_design [OUT_DIR] [--data DIR] [--corpus] [--mesh SUBSTRING]... [--material SPEC]... "
-                   "[--resolution N] [--max-time S] [--volume-ratio R] [--method adjoint|alm] [--coarse-vertices N] [--surface-growth F] "
+                   "[--resolution N] [--max-time S] [--max-iterations N] [--volume-ratio R] [--method adjoint|alm] [--coarse-vertices N] [--surface-growth F] "
                    "[--surface-growth-iterations N] [--k-surface K] [--quick]\n");
       return 2;
     }
@@ -294,6 +298,7 @@ int main(int argc, char** argv) {
         options.volume_ratio = volume_ratio;
         options.method = method;
         options.max_time_s = max_time_s;
+        options.max_iterations = max_iterations;
         options.coarse_vertices = coarse_vertices;
         options.surface_growth = surface_growth;
         options.surface_growth_iterations = surface_growth_iterations;

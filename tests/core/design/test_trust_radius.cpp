@@ -32,6 +32,14 @@ TEST(TrustRadius, AnUncutStepGrowsItOnlyWhenTheModelAgreed) {
   EXPECT_DOUBLE_EQ(trust.radius(), 3.0) << "never past its largest";
 }
 
+TEST(TrustRadius, AShortStepThatDisagreedShrinksItAtMostFourfold) {
+  // The latex cactus near a fold: a Gauss-Newton direction of 7e-5 mm inside a 0.05 mm radius disagreed
+  // with its model; half that move as the radius cost ten iterations of doubling it back.
+  TrustRadius trust(0.05);
+  trust.after_step(1.0, 1.0, 7e-5, 0.2, true);
+  EXPECT_DOUBLE_EQ(trust.radius(), 0.0125);
+}
+
 TEST(TrustRadius, StepsWithoutAModelGrowItWhenUncut) {
   TrustRadius trust(3.0);
   trust.after_step(0.5, 0.25, 10.0, 1.0, false);
