@@ -297,7 +297,7 @@ class ReducedSpaceDesign {
           switched = true;
           // What the radius learned on the branch left behind says nothing about this one: shrunk there
           // (latex bear: seven halvings in one iteration), it took eight iterations to grow back.
-          trust = TrustRadius(MAX_TRUST_RADIUS_REL * result.bbox_diag_mm);
+          trust.start_over();
           m_objective.realign(m_x);
           const SurfaceDistanceStats reached = m_surface.aligned_stats(unflatten(m_x), m_target.vertices);
           m_driver.remember_if_best(rest, reached.avg_mm);

@@ -17,6 +17,9 @@ class TrustRadius {
 
   double radius() const { return m_radius; }
 
+  /// Back to its largest: what it learned no longer applies (the design moved to another branch).
+  void start_over() { m_radius = m_max; }
+
   /// After an accepted step t of a direction whose largest vertex move is `largest_mm`, first tried at
   /// `first_t` (the radius' cut): cut k times, the radius shrinks by 2^k (t / first_t); uncut, a
   /// Gauss-Newton step whose decrease was under a quarter of its model's (`agreement`) halves the move

@@ -40,6 +40,13 @@ TEST(TrustRadius, AShortStepThatDisagreedShrinksItAtMostFourfold) {
   EXPECT_DOUBLE_EQ(trust.radius(), 0.0125);
 }
 
+TEST(TrustRadius, StartingOverForgetsWhatItLearned) {
+  TrustRadius trust(3.0);
+  trust.after_step(1.0, 1.0 / 128.0, 10.0, 1.0, true);  // seven halvings
+  trust.start_over();
+  EXPECT_DOUBLE_EQ(trust.radius(), 3.0);
+}
+
 TEST(TrustRadius, StepsWithoutAModelGrowItWhenUncut) {
   TrustRadius trust(3.0);
   trust.after_step(0.5, 0.25, 10.0, 1.0, false);
