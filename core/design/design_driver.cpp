@@ -61,6 +61,11 @@ double design_clock_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+bool design_debug() {
+  static const bool debug = std::getenv("BALLOON_DEBUG_DESIGN") != nullptr;
+  return debug;
+}
+
 void stop_with(DesignResult& result, DesignStop stop, std::string message) {
   result.stop = stop;
   result.message = std::move(message);
@@ -265,7 +270,7 @@ bool DesignDriver::take_shape_from_rest(const Eigen::VectorXd& rest) {
   const Positions current = unflatten(m_x);
   const double deviation = deviation_from_design_mm(inflated.deformed, current, m_model.faces());
   const double error = m_objective.surface().aligned_stats(current, m_target.vertices).avg_mm;
-  if (std::getenv("BALLOON_DEBUG_DESIGN"))
+  if (design_debug())
     std::fprintf(stderr, "  from rest: %.3g mm from the design's shape (its error %.3g mm), %.4g kPa against %.4g kPa\n",
                  deviation, error, inflated.pressure_kpa, m_pressure / MPA_PER_KPA);
   if (!is_another_shape(deviation, error, m_objective.surface().bbox_diagonal_mm())) return false;
@@ -283,7 +288,7 @@ bool DesignDriver::trial_start_in_range(const Eigen::VectorXd& rest, const Eigen
   m_model.set_rest_positions(unflatten(rest));
   const double residual = m_solver.residual(x, pressure).norm();
   const double scale = m_solver.force_scale(x, pressure);
-  if (std::getenv("BALLOON_DEBUG_DESIGN"))
+  if (design_debug())
     std::fprintf(stderr, "  trial start residual %.3g N, force scale %.3g N\n", residual, scale);
   return std::isfinite(residual) && residual <= PREDICTOR_RESIDUAL_LIMIT * scale;
 }
@@ -387,7 +392,7 @@ DesignResult& DesignDriver::finish(DesignResult& result, const Eigen::VectorXd& 
 }
 
 void DesignDriver::debug_time(const char* what) const {
-  if (std::getenv("BALLOON_DEBUG_DESIGN")) std::fprintf(stderr, "  %s done at %.2f s\n", what, design_clock_s() - m_start);
+  if (design_debug()) std::fprintf(stderr, "  %s done at %.2f s\n", what, design_clock_s() - m_start);
 }
 
 }  // namespace balloon

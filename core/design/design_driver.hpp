@@ -26,6 +26,9 @@ TriMesh design_start_shape(const TriMesh& target, const DesignOptions& options);
 /// Steady-clock seconds (the clock of NewtonSettings::deadline_s).
 double design_clock_s();
 
+/// Whether BALLOON_DEBUG_DESIGN asks for the design's trace on stderr (read once).
+bool design_debug();
+
 /// Sets the stop reason and its sentence.
 void stop_with(DesignResult& result, DesignStop stop, std::string message);
 

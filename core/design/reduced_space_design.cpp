@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 #include <utility>
 #include <vector>
@@ -175,12 +174,12 @@ class ReducedSpaceDesign {
         trial_x = m_x + t * response;
         trial_pressure = m_pressure + t * pressure_response;
         if (!m_driver.trial_start_in_range(trial_rest, trial_x, trial_pressure)) {
-          if (std::getenv("BALLOON_DEBUG_DESIGN"))
+          if (design_debug())
             std::fprintf(stderr, "  it %d trial %d t=%.3g: the predictor is out of range\n", iteration, k, t);
           continue;
         }
         const bool balanced = m_driver.equilibrium(trial_rest, trial_x, trial_pressure);
-        if (std::getenv("BALLOON_DEBUG_DESIGN"))
+        if (design_debug())
           std::fprintf(stderr, "  it %d trial %d t=%.3g newton %d %s (%.2f s)\n", iteration, k, t,
                        m_last_report.iterations, m_last_report.message.c_str(), design_clock_s() - m_driver.start_time());
         if (!balanced) {
@@ -194,7 +193,7 @@ class ReducedSpaceDesign {
           continue;
         }
         trial_objective = m_objective.value(trial_rest, trial_x);
-        if (std::getenv("BALLOON_DEBUG_DESIGN"))
+        if (design_debug())
           std::fprintf(stderr, "    objective %.9g -> %.9g (change %.3g, asked %.3g, first order %.3g)\n", objective,
                        trial_objective, trial_objective - objective, 1e-4 * t * slope, t * slope);
         if (trial_objective <= objective + 1e-4 * t * slope) {
@@ -237,7 +236,7 @@ class ReducedSpaceDesign {
       }
       const double model_decrease = gauss_newton_model_decrease(t, slope);
       const double agreement = model_decrease > 0.0 ? (objective - trial_objective) / model_decrease : 1.0;
-      if (std::getenv("BALLOON_DEBUG_DESIGN"))
+      if (design_debug())
         std::fprintf(stderr, "    step: gauss-newton %d, largest move %.3g mm at t = 1, radius %.3g mm, agreement %.3g\n",
                      newton_like ? 1 : 0, largest, trust.radius(), agreement);
       trust.after_step(first_t, t, largest, agreement, newton_like);
