@@ -24,3 +24,27 @@ void use_one_linear_algebra_thread() {
 }
 
 }  // namespace balloon
+
+using OpenMpRegionBody = void (*)(void*);
+using OpenMpParallel = void (*)(OpenMpRegionBody, void*, unsigned, unsigned);
+
+/// GCC's entry to `#pragma omp parallel` (libgomp's ABI), defined in this process so that it is found
+/// before libgomp's for every library loaded: linked into an executable whose shared libraries call it,
+/// the linker exports it, and the executable comes first in symbol lookup.
+///
+/// Why: CHOLMOD 3 (Debian 12) opens a parallel region for every supernode it factorizes and for every
+/// descendant's update of it. With one thread each region still costs libgomp a team, a barrier and a
+/// futex system call (with dynamic adjustment, a getloadavg and a sched_getaffinity besides): about
+/// 700,000 regions per design iteration at 4,000 vertices, 8-10% of the run time in system calls alone.
+/// The linear algebra runs on one thread here anyway (above), so a region's body runs on the calling
+/// thread as a plain call, with the same results. A user who set OMP_NUM_THREADS gets libgomp's own.
+extern "C" void GOMP_parallel(OpenMpRegionBody body, void* data, unsigned num_threads, unsigned flags) {
+  static const OpenMpParallel libgomp_parallel =
+      std::getenv("OMP_NUM_THREADS") != nullptr ? reinterpret_cast<OpenMpParallel>(dlsym(RTLD_NEXT, "GOMP_parallel"))
+                                                : nullptr;
+  if (libgomp_parallel != nullptr) {
+    libgomp_parallel(body, data, num_threads, flags);
+    return;
+  }
+  body(data);
+}
