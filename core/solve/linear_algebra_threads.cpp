@@ -18,8 +18,8 @@ void use_one_linear_algebra_thread() {
   openmp_done = true;
   if (std::getenv("OMP_NUM_THREADS") != nullptr) return;
   if (auto set_threads = loaded_function<void (*)(int)>("omp_set_num_threads")) set_threads(1);
-  // CHOLMOD asks for a fixed team size in its supernodal kernels (num_threads(4)); with dynamic
-  // adjustment on, the runtime may give fewer threads than asked, down to what the machine has free.
+  // For the OpenMP entries other than GOMP_parallel (below), which run in libgomp's teams: a fixed team
+  // size asked for (CHOLMOD's num_threads(4)) is then cut down to what the machine has free.
   if (auto set_dynamic = loaded_function<void (*)(int)>("omp_set_dynamic")) set_dynamic(1);
 }
 
