@@ -13,14 +13,6 @@ void use_one_linear_algebra_thread() {
     if (std::getenv("OPENBLAS_NUM_THREADS") != nullptr) return;
     if (auto set_threads = loaded_function<void (*)(int)>("openblas_set_num_threads")) set_threads(1);
   });
-  thread_local bool openmp_done = false;
-  if (openmp_done) return;
-  openmp_done = true;
-  if (std::getenv("OMP_NUM_THREADS") != nullptr) return;
-  if (auto set_threads = loaded_function<void (*)(int)>("omp_set_num_threads")) set_threads(1);
-  // For the OpenMP entries other than GOMP_parallel (below), which run in libgomp's teams: a fixed team
-  // size asked for (CHOLMOD's num_threads(4)) is then cut down to what the machine has free.
-  if (auto set_dynamic = loaded_function<void (*)(int)>("omp_set_dynamic")) set_dynamic(1);
 }
 
 }  // namespace balloon
@@ -37,7 +29,9 @@ using OpenMpParallel = void (*)(OpenMpRegionBody, void*, unsigned, unsigned);
 /// futex system call (with dynamic adjustment, a getloadavg and a sched_getaffinity besides): about
 /// 700,000 regions per design iteration at 4,000 vertices, 8-10% of the run time in system calls alone.
 /// The linear algebra runs on one thread here anyway (above), so a region's body runs on the calling
-/// thread as a plain call, with the same results. A user who set OMP_NUM_THREADS gets libgomp's own.
+/// thread as a plain call, with the same results. (It is the only OpenMP entry the loaded libraries call,
+/// so no team size or dynamic adjustment needs setting.) A user who set OMP_NUM_THREADS gets libgomp's
+/// own, found with RTLD_NEXT: loaded_function's RTLD_DEFAULT would find this one.
 extern "C" void GOMP_parallel(OpenMpRegionBody body, void* data, unsigned num_threads, unsigned flags) {
   static const OpenMpParallel libgomp_parallel =
       std::getenv("OMP_NUM_THREADS") != nullptr ? reinterpret_cast<OpenMpParallel>(dlsym(RTLD_NEXT, "GOMP_parallel"))

@@ -6,8 +6,8 @@
 /// the calling thread (GOMP_parallel, defined in linear_algebra_threads.cpp), unless OMP_NUM_THREADS is set.
 namespace balloon {
 
-/// Limits OpenBLAS (process-wide) and OpenMP (for the calling thread) to one thread, unless the user
-/// set OPENBLAS_NUM_THREADS or OMP_NUM_THREADS. Cheap to call again; call it on every solving thread.
+/// Limits OpenBLAS (process-wide) to one thread, unless the user set OPENBLAS_NUM_THREADS. Cheap to call
+/// again. (OpenMP needs no call: its regions run inline, see above.)
 void use_one_linear_algebra_thread();
 
 }  // namespace balloon
