@@ -2,6 +2,8 @@
 
 #include "solve/loaded_function.hpp"
 
+#include <dlfcn.h>
+
 #include <cstdlib>
 #include <mutex>
 
