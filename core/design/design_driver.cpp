@@ -262,22 +262,34 @@ bool DesignDriver::equilibrium(const Eigen::VectorXd& rest, Eigen::VectorXd& x, 
   return m_last_report.converged;
 }
 
-bool DesignDriver::take_shape_from_rest(const Eigen::VectorXd& rest) {
-  m_model.set_rest_positions(unflatten(rest));
+void DesignDriver::start_shape_from_rest(const Eigen::VectorXd& rest) {
+  m_from_rest_rest = rest;
+  m_from_rest_design_x = m_x;
+  m_from_rest_design_error = m_objective.surface().aligned_stats(unflatten(m_x), m_target.vertices).avg_mm;
   // The forward solver's own path settings, as balloon simulate uses them (the start keeps the design's).
-  const InflationResult inflated = inflate(TriMesh{unflatten(rest), m_model.faces()}, inflation_from_rest(rest));
+  m_from_rest.start(TriMesh{unflatten(rest), m_model.faces()}, inflation_from_rest(rest));
+}
+
+bool DesignDriver::take_pending_shape_from_rest(Eigen::VectorXd& rest) {
+  if (!m_from_rest.running()) return false;
+  const double waited_from = design_clock_s();
+  const InflationResult inflated = m_from_rest.wait();
+  if (design_debug()) std::fprintf(stderr, "  waited %.2f s for the check from rest\n", design_clock_s() - waited_from);
   if (!inflated.converged) return false;
-  const Positions current = unflatten(m_x);
-  const double deviation = deviation_from_design_mm(inflated.deformed, current, m_model.faces());
-  const double error = m_objective.surface().aligned_stats(current, m_target.vertices).avg_mm;
+  const double deviation = deviation_from_design_mm(inflated.deformed, unflatten(m_from_rest_design_x), m_model.faces());
   if (design_debug())
-    std::fprintf(stderr, "  from rest: %.3g mm from the design's shape (its error %.3g mm), %.4g kPa against %.4g kPa\n",
-                 deviation, error, inflated.pressure_kpa, m_pressure / MPA_PER_KPA);
-  if (!is_another_shape(deviation, error, m_objective.surface().bbox_diagonal_mm())) return false;
+    std::fprintf(stderr, "  from rest: %.3g mm from the design's shape (its error %.3g mm), %.4g kPa\n", deviation,
+                 m_from_rest_design_error, inflated.pressure_kpa);
+  if (!is_another_shape(deviation, m_from_rest_design_error, m_objective.surface().bbox_diagonal_mm())) return false;
+  m_model.set_rest_positions(unflatten(m_from_rest_rest));
   if (inflated.bending && !m_model.bending()) set_bending(true);
   Eigen::VectorXd x = flat(inflated.deformed);
   double pressure = inflated.pressure_kpa * MPA_PER_KPA;
-  if (!m_solver.solve_volume(x, pressure, m_target_volume, m_settings).converged) return false;
+  if (!m_solver.solve_volume(x, pressure, m_target_volume, m_settings).converged) {
+    m_model.set_rest_positions(unflatten(rest));
+    return false;
+  }
+  rest = m_from_rest_rest;
   m_x = flat(rigid_align_to(unflatten(x), m_target.vertices));
   m_pressure = pressure;
   m_best_error = std::numeric_limits<double>::infinity();
@@ -366,6 +378,7 @@ bool DesignDriver::restore_best_equilibrium(Eigen::VectorXd& rest) {
 }
 
 DesignResult& DesignDriver::finish(DesignResult& result, const Eigen::VectorXd& rest) {
+  m_from_rest.abandon();  // a check still running concerns a rest shape the design has left
   result.rest = m_target;
   result.rest.vertices = unflatten(rest);
   result.time_s = design_clock_s() - m_start;

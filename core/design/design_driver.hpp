@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "design/adjoint_sensitivity.hpp"
+#include "design/background_inflation.hpp"
 #include "design/balloon_design.hpp"
 #include "design/design_objective.hpp"
 #include "fem/balloon_model.hpp"
@@ -81,10 +82,18 @@ class DesignDriver {
   /// non-finite or beyond 1e10 times the force scale (PREDICTOR_RESIDUAL_LIMIT: a predictor carried past the
   /// linear range, where a stiffening rubber's forces explode).
   bool trial_start_in_range(const Eigen::VectorXd& rest, const Eigen::VectorXd& x, double pressure);
-  /// Inflates `rest` from rest as `balloon simulate` does; where that reaches another shape than the
-  /// current equilibrium (farther from it than the current error), the design goes on from that shape,
-  /// placed on the target, and forgets the best design seen. True when it switched.
-  bool take_shape_from_rest(const Eigen::VectorXd& rest);
+  /// Starts inflating `rest` from rest as `balloon simulate` does, on a thread of its own (a check
+  /// still running is abandoned), and notes the current equilibrium, to which take_pending_shape_from_rest
+  /// compares the shape reached.
+  void start_shape_from_rest(const Eigen::VectorXd& rest);
+  /// Whether a check started by start_shape_from_rest awaits take_pending_shape_from_rest.
+  bool shape_from_rest_pending() const { return m_from_rest.running(); }
+  /// Waits for the check start_shape_from_rest started. Where it reached another shape than the
+  /// equilibrium noted then (farther from it than that equilibrium's error), the design goes back to the
+  /// check's rest shape and goes on from the shape reached, placed on the target: `rest`, x and pressure
+  /// are replaced and the best design seen is forgotten. True when it switched; false with nothing
+  /// changed otherwise (no check pending, the check did not converge, or it reached the design's shape).
+  bool take_pending_shape_from_rest(Eigen::VectorXd& rest);
   /// Whether the last Newton solve stopped on the cancel token or the deadline.
   bool stopped() const;
 
@@ -117,7 +126,7 @@ class DesignDriver {
   /// the active term "sheet_bending").
   bool inflate_start_to_target_volume(const Eigen::VectorXd& rest, DesignResult& result);
   /// Volume control from `rest` to the target's volume with the model's material and thickness, to the
-  /// design's tolerance, within the design's deadline: what the start and take_shape_from_rest share.
+  /// design's tolerance, within the design's deadline: what the start and the checks from rest share.
   InflationOptions inflation_from_rest(const Eigen::VectorXd& rest) const;
   /// The sheet's bending on or off in the model, and the solver's pattern to match.
   void set_bending(bool on);
@@ -140,6 +149,11 @@ class DesignDriver {
   Eigen::VectorXd m_best_rest, m_best_x;
   double m_best_pressure = 0.0;
   bool m_final_equilibrium = true;
+  /// The check from rest running meanwhile: its rest shape, and the design's equilibrium and average
+  /// error (mm) when it started.
+  BackgroundInflation m_from_rest;
+  Eigen::VectorXd m_from_rest_rest, m_from_rest_design_x;
+  double m_from_rest_design_error = 0.0;
 };
 
 }  // namespace balloon

@@ -67,23 +67,48 @@ TEST(DesignDriver, TheShapeReachedFromRestLeavesTheDesignsAloneAndReplacesAnothe
   // not reach; the driver then goes on from the shape that inflation reaches.
   EllipsoidDesign design(DesignMethod::Adjoint);
   DesignDriver& driver = design.driver;
-  const Eigen::VectorXd& rest = design.start;
   ASSERT_TRUE(design.inflate_start()) << design.result.message;
   const Eigen::VectorXd start_x = driver.x();
   const double start_pressure = driver.pressure();
+  EXPECT_FALSE(driver.shape_from_rest_pending());
+  Eigen::VectorXd rest = design.start;
+  EXPECT_FALSE(driver.take_pending_shape_from_rest(rest)) << "no check was started";
 
   // Silicone here has one equilibrium per volume: from rest it reaches the driver's own shape.
-  EXPECT_FALSE(driver.take_shape_from_rest(rest));
+  driver.start_shape_from_rest(rest);
+  EXPECT_TRUE(driver.shape_from_rest_pending());
+  EXPECT_FALSE(driver.take_pending_shape_from_rest(rest));
+  EXPECT_FALSE(driver.shape_from_rest_pending());
   EXPECT_EQ(driver.x(), start_x);
+  EXPECT_EQ(rest, design.start);
 
   // On the target itself (no error, but no equilibrium of this rest shape) the shape reached from rest is
   // another one: the start's inflation again, placed on the target, and the best design seen is forgotten.
+  // The check runs while the design goes on; its verdict concerns the rest shape it started from, to which
+  // the design goes back.
   driver.x() = flat(design.target.vertices);
-  ASSERT_TRUE(driver.take_shape_from_rest(rest));
+  driver.start_shape_from_rest(rest);
+  Eigen::VectorXd moved_on = 1.01 * rest;
+  driver.x() = 1.01 * start_x;
+  ASSERT_TRUE(driver.take_pending_shape_from_rest(moved_on));
+  EXPECT_EQ(moved_on, design.start);
   EXPECT_LT((driver.x() - start_x).cwiseAbs().maxCoeff(), 1e-3);  // mm, on a 65 mm balloon
   EXPECT_NEAR(driver.pressure(), start_pressure, 1e-6 * start_pressure);
   Eigen::VectorXd best = rest;
   EXPECT_FALSE(driver.restore_best_equilibrium(best)) << "the best design seen belonged to the other shape";
+}
+
+TEST(DesignDriver, ACheckFromRestStillRunningWhenTheDesignEndsIsAbandoned) {
+  EllipsoidDesign design(DesignMethod::Adjoint);
+  DesignDriver& driver = design.driver;
+  ASSERT_TRUE(design.inflate_start()) << design.result.message;
+  driver.x() = flat(design.target.vertices);  // a check would switch, were it taken
+  driver.start_shape_from_rest(design.start);
+  driver.finish(design.result, design.start);
+  EXPECT_FALSE(driver.shape_from_rest_pending());
+  Eigen::VectorXd rest = design.start;
+  EXPECT_FALSE(driver.take_pending_shape_from_rest(rest));
+  EXPECT_EQ(driver.x(), flat(design.target.vertices));
 }
 
 TEST(DesignDriver, ATrialStartFarPastTheLinearRangeIsNotWorthNewtonSteps) {
