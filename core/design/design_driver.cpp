@@ -265,7 +265,6 @@ bool DesignDriver::equilibrium(const Eigen::VectorXd& rest, Eigen::VectorXd& x, 
 void DesignDriver::start_shape_from_rest(const Eigen::VectorXd& rest) {
   m_from_rest_rest = rest;
   m_from_rest_design_x = m_x;
-  m_from_rest_design_error = m_objective.surface().aligned_stats(unflatten(m_x), m_target.vertices).avg_mm;
   // The forward solver's own path settings, as balloon simulate uses them (the start keeps the design's).
   m_from_rest.start(TriMesh{unflatten(rest), m_model.faces()}, inflation_from_rest(rest));
 }
@@ -276,11 +275,13 @@ bool DesignDriver::take_pending_shape_from_rest(Eigen::VectorXd& rest) {
   const InflationResult inflated = m_from_rest.wait();
   if (design_debug()) std::fprintf(stderr, "  waited %.2f s for the check from rest\n", design_clock_s() - waited_from);
   if (!inflated.converged) return false;
-  const double deviation = deviation_from_design_mm(inflated.deformed, unflatten(m_from_rest_design_x), m_model.faces());
+  const Positions design_x = unflatten(m_from_rest_design_x);
+  const double deviation = deviation_from_design_mm(inflated.deformed, design_x, m_model.faces());
+  const double design_error = m_objective.surface().aligned_stats(design_x, m_target.vertices).avg_mm;
   if (design_debug())
     std::fprintf(stderr, "  from rest: %.3g mm from the design's shape (its error %.3g mm), %.4g kPa\n", deviation,
-                 m_from_rest_design_error, inflated.pressure_kpa);
-  if (!is_another_shape(deviation, m_from_rest_design_error, m_objective.surface().bbox_diagonal_mm())) return false;
+                 design_error, inflated.pressure_kpa);
+  if (!is_another_shape(deviation, design_error, m_objective.surface().bbox_diagonal_mm())) return false;
   m_model.set_rest_positions(unflatten(m_from_rest_rest));
   if (inflated.bending && !m_model.bending()) set_bending(true);
   Eigen::VectorXd x = flat(inflated.deformed);

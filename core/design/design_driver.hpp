@@ -149,11 +149,9 @@ class DesignDriver {
   Eigen::VectorXd m_best_rest, m_best_x;
   double m_best_pressure = 0.0;
   bool m_final_equilibrium = true;
-  /// The check from rest running meanwhile: its rest shape, and the design's equilibrium and average
-  /// error (mm) when it started.
+  /// The check from rest running meanwhile: its rest shape, and the design's equilibrium when it started.
   BackgroundInflation m_from_rest;
   Eigen::VectorXd m_from_rest_rest, m_from_rest_design_x;
-  double m_from_rest_design_error = 0.0;
 };
 
 }  // namespace balloon
