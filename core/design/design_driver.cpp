@@ -23,6 +23,8 @@ constexpr int TRIAL_NEWTON_ITERATIONS = 10;
 constexpr int PATIENT_TRIAL_NEWTON_ITERATIONS = 30;
 /// A trial whose Newton stagnates within this many force tolerances (NewtonSettings) is an equilibrium.
 constexpr double TRIAL_STAGNATION_FACTOR = 10.0;
+/// Newton steps settle() gives a stagnated equilibrium to reach the tolerance itself.
+constexpr int SETTLE_NEWTON_ITERATIONS = 30;
 /// A trial's predictor whose residual is this many times the force scale (the pressure's) is out of range.
 /// On the silicone corpus the trials that converged started at up to 1e7 times; all but one of those that
 /// failed at the Newton limit (30 steps each), at 1e20-1e89 times (Hart-Smith's exponential past the
@@ -260,6 +262,21 @@ bool DesignDriver::equilibrium(const Eigen::VectorXd& rest, Eigen::VectorXd& x, 
   settings.exact_hessian_near_saddles = false;
   m_last_report = m_solver.solve_volume(x, pressure, m_target_volume, settings);
   return m_last_report.converged;
+}
+
+bool DesignDriver::settle(const Eigen::VectorXd& rest) {
+  m_model.set_rest_positions(unflatten(rest));
+  NewtonSettings settings = m_settings;
+  settings.stagnation_tolerance_factor = 0.0;
+  settings.max_iterations = SETTLE_NEWTON_ITERATIONS;
+  Eigen::VectorXd x = m_x;
+  double pressure = m_pressure;
+  const NewtonReport settled = m_solver.solve_volume(x, pressure, m_target_volume, settings);
+  if (design_debug()) std::fprintf(stderr, "  settling: newton %d %s\n", settled.iterations, settled.message.c_str());
+  if (!settled.converged) return false;
+  m_x = x;
+  m_pressure = pressure;
+  return true;
 }
 
 void DesignDriver::start_shape_from_rest(const Eigen::VectorXd& rest) {

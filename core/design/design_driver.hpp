@@ -78,6 +78,10 @@ class DesignDriver {
   /// Volume-controlled equilibrium of `rest` from (x, p) with a short Newton budget; false when it does
   /// not converge (last_report() says why).
   bool equilibrium(const Eigen::VectorXd& rest, Eigen::VectorXd& x, double& pressure);
+  /// Takes the current equilibrium of `rest`, accepted where Newton stagnated within a few tolerances,
+  /// on to the force tolerance itself (SETTLE_NEWTON_ITERATIONS steps): x and pressure are replaced
+  /// where it gets there; false, with nothing changed, where it does not.
+  bool settle(const Eigen::VectorXd& rest);
   /// Whether a trial's start (x, pressure) with `rest` is worth Newton steps: false where its residual is
   /// non-finite or beyond 1e10 times the force scale (PREDICTOR_RESIDUAL_LIMIT: a predictor carried past the
   /// linear range, where a stiffening rubber's forces explode).

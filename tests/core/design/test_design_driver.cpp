@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "design/design_driver.hpp"
+#include "design/surface_distance.hpp"
 #include "design_test_meshes.hpp"
 
 namespace balloon {
@@ -60,6 +62,34 @@ TEST(DesignDriver, SwitchingBendingOnKeepsAnEquilibriumAndListsTheTerm) {
 
   EXPECT_FALSE(driver.switch_bending_on(rest, result)) << "once only";
   EXPECT_EQ(std::count(result.active_terms.begin(), result.active_terms.end(), "sheet_bending"), 1);
+}
+
+TEST(DesignDriver, SettlingTakesAnEquilibriumShortOfTheToleranceOnToIt) {
+  EllipsoidDesign design(DesignMethod::Adjoint);
+  DesignDriver& driver = design.driver;
+  ASSERT_TRUE(design.inflate_start()) << design.result.message;
+  const Eigen::VectorXd balanced = driver.x();
+  const double balanced_pressure = driver.pressure();
+  // Moved off its equilibrium by a micrometre along a smooth field: a state Newton's stagnation allowance
+  // could have accepted, short of the force tolerance.
+  Eigen::VectorXd moved = balanced;
+  for (int c = 0; c < moved.size(); ++c) moved[c] += 1e-3 * std::sin(0.7 * c);
+  driver.x() = moved;
+  Eigen::VectorXd x = moved;
+  double pressure = balanced_pressure;
+  ASSERT_TRUE(driver.equilibrium(design.start, x, pressure));
+  ASSERT_GT(driver.last_report().iterations, 0) << "the moved state is not at the tolerance";
+
+  ASSERT_TRUE(driver.settle(design.start));
+  // Settled: Newton from there has nothing left to do, and it is the equilibrium it was moved off.
+  x = driver.x();
+  pressure = driver.pressure();
+  ASSERT_TRUE(driver.equilibrium(design.start, x, pressure));
+  EXPECT_EQ(driver.last_report().iterations, 0);
+  // (up to a rigid motion, which the moved state's field partly was)
+  const Positions aligned = rigid_align_to(unflatten(driver.x()), unflatten(balanced));
+  EXPECT_LT((aligned - unflatten(balanced)).cwiseAbs().maxCoeff(), 1e-4);
+  EXPECT_NEAR(driver.pressure(), balanced_pressure, 1e-6 * balanced_pressure);
 }
 
 TEST(DesignDriver, TheShapeReachedFromRestLeavesTheDesignsAloneAndReplacesAnotherOne) {
