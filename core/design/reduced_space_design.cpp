@@ -240,10 +240,7 @@ class ReducedSpaceDesign {
       }
       if (bending_switched) {
         stagnated = false;
-        m_objective.realign(m_x);
-        objective = m_objective.value(rest, m_x);
-        m_lbfgs.clear();
-        if (!objective_gradient(rest, gradient)) {
+        if (!restart_at_equilibrium(rest, objective, gradient)) {
           stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized");
           break;
         }
@@ -264,10 +261,7 @@ class ReducedSpaceDesign {
         // but spent 30 Newton steps on each that did not settle, where no line search had failed.
         if (stagnated && m_driver.settle(rest)) {
           stagnated = false;
-          m_objective.realign(m_x);
-          objective = m_objective.value(rest, m_x);
-          m_lbfgs.clear();
-          if (!objective_gradient(rest, gradient)) {
+          if (!restart_at_equilibrium(rest, objective, gradient)) {
             stop_with(result, DesignStop::Stalled, "stalled: the adjoint system could not be factorized");
             break;
           }
@@ -405,6 +399,16 @@ class ReducedSpaceDesign {
   }
 
  private:
+  /// The equilibrium of the same rest shape changed (the sheet's bending switched on, or settled): the
+  /// objective, its gradient and the curvature pairs start over there. False where the adjoint system
+  /// could not be factorized.
+  bool restart_at_equilibrium(const Eigen::VectorXd& rest, double& objective, Eigen::VectorXd& gradient) {
+    m_objective.realign(m_x);
+    objective = m_objective.value(rest, m_x);
+    m_lbfgs.clear();
+    return objective_gradient(rest, gradient);
+  }
+
   /// d objective / d rest through the adjoint of the bordered equilibrium system at (m_x, m_pressure):
   /// [K -v; -v^T 0] [lambda; mu] = [dE/dx; 0], gradient = -(d grad_x W / d rest)^T lambda.
   bool objective_gradient(const Eigen::VectorXd& rest, Eigen::VectorXd& gradient) {
