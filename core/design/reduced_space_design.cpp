@@ -268,7 +268,8 @@ class ReducedSpaceDesign {
           m_driver.debug_time("settled");
           continue;
         }
-        if (newton_like || !m_lbfgs.empty()) {  // a stale curvature model: restart from steepest descent
+        // Steepest descent next: L-BFGS's curvature pairs may be stale, and Gauss-Newton would be the same again.
+        if (newton_like || !m_lbfgs.empty()) {
           gauss_newton_failed = newton_like;
           m_lbfgs.clear();
           continue;

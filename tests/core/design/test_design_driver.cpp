@@ -70,8 +70,8 @@ TEST(DesignDriver, SettlingTakesAnEquilibriumShortOfTheToleranceOnToIt) {
   ASSERT_TRUE(design.inflate_start()) << design.result.message;
   const Eigen::VectorXd balanced = driver.x();
   const double balanced_pressure = driver.pressure();
-  // Moved off its equilibrium by a micrometre along a smooth field: a state Newton's stagnation allowance
-  // could have accepted, short of the force tolerance.
+  // Moved off its equilibrium by up to a micrometre per coordinate: a state short of the force tolerance,
+  // as one Newton's stagnation allowance accepted would be.
   Eigen::VectorXd moved = balanced;
   for (int c = 0; c < moved.size(); ++c) moved[c] += 1e-3 * std::sin(0.7 * c);
   driver.x() = moved;
