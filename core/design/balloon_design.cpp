@@ -7,6 +7,7 @@
 #include "design/design_driver.hpp"
 #include "design/multiresolution_design.hpp"
 #include "design/reduced_space_design.hpp"
+#include "design/closest_from_rest.hpp"
 #include "design/rest_inflation_check.hpp"
 #include "material/thin_sheet.hpp"
 #include "mesh/mesh_geometry.hpp"
@@ -99,8 +100,10 @@ void add_rest_inflation_check(const TriMesh& target, const DesignOptions& option
   inflation.volume_ratio = *result.volume_ratio;
   inflation.max_time_s = REST_INFLATION_CHECK_TIME_LIMIT_S;
   inflation.cancel = options.cancel;
+  const SurfaceDistance target_surface(target);
   result.from_rest = check_inflation_from_rest(result.rest, inflation, result.inflated, *result.avg_error_mm,
-                                               SurfaceDistance(target), target.vertices);
+                                               target_surface, target.vertices);
+  hand_back_closest_from_rest(target, target_surface, inflation, result);
 }
 
 }  // namespace

@@ -117,6 +117,15 @@ struct CoarseStage {
   bool carried = false;
 };
 
+/// A rest shape of the run whose inflation from rest was measured along the way: the start (its
+/// inflation is the forward solver's volume path from rest) and, past a pressure maximum, the rest
+/// shapes checked from rest as the design went (DesignDriver::take_pending_shape_from_rest).
+struct CheckedFromRest {
+  Positions rest;               ///< #V by 3 (mm)
+  double avg_error_mm = 0.0;    ///< its shape from rest against the target (mm), aligned as the error is
+  int iteration = 0;            ///< the design iteration it is the rest shape of (0: the start)
+};
+
 struct DesignResult {
   bool converged = false;              ///< stop is Matched or Optimal, and the returned shape is an equilibrium
   DesignStop stop = DesignStop::StartFailed;
@@ -152,6 +161,10 @@ struct DesignResult {
   /// The rest shape inflated from rest as `balloon simulate` does (DesignOptions::check_from_rest); none
   /// without a design or with the check off.
   std::optional<RestInflationCheck> from_rest;
+  /// Of the rest shapes checked from rest during the run, the one whose shape from rest came closest to
+  /// the target; none without an inflated start. Where the final design inflates from rest farther
+  /// from the target, or finds no equilibrium there, this one is handed back (balloon_design.cpp).
+  std::optional<CheckedFromRest> closest_from_rest;
 };
 
 /// Designs the rest shape for `target`. Never throws for bad numerics: failures are in the result.

@@ -112,6 +112,7 @@ bool DesignDriver::inflate_start(const Eigen::VectorXd& rest, DesignResult& resu
   result.baseline_max_error_mm = baseline.max_mm;
   record(result, 0, baseline, rest);
   remember_if_best(rest, baseline.avg_mm);
+  remember_if_closest_from_rest(rest, baseline.avg_mm, 0);
   debug_time("baseline error");
   return true;
 }
@@ -279,8 +280,9 @@ bool DesignDriver::settle(const Eigen::VectorXd& rest) {
   return true;
 }
 
-void DesignDriver::start_shape_from_rest(const Eigen::VectorXd& rest) {
+void DesignDriver::start_shape_from_rest(const Eigen::VectorXd& rest, int iteration) {
   m_from_rest_rest = rest;
+  m_from_rest_iteration = iteration;
   m_from_rest_design_x = m_x;
   // The forward solver's own path settings, as balloon simulate uses them (the start keeps the design's).
   m_from_rest.start(TriMesh{unflatten(rest), m_model.faces()}, inflation_from_rest(rest));
@@ -295,6 +297,9 @@ bool DesignDriver::take_pending_shape_from_rest(Eigen::VectorXd& rest) {
   const Positions design_x = unflatten(m_from_rest_design_x);
   const double deviation = deviation_from_design_mm(inflated.deformed, design_x, m_model.faces());
   const double design_error = m_objective.surface().aligned_stats(design_x, m_target.vertices).avg_mm;
+  remember_if_closest_from_rest(m_from_rest_rest,
+                                m_objective.surface().aligned_stats(inflated.deformed, m_target.vertices).avg_mm,
+                                m_from_rest_iteration);
   if (design_debug())
     std::fprintf(stderr, "  from rest: %.3g mm from the design's shape (its error %.3g mm), %.4g kPa\n", deviation,
                  design_error, inflated.pressure_kpa);
@@ -377,6 +382,11 @@ void DesignDriver::remember_if_best(const Eigen::VectorXd& rest, double avg_erro
   m_best_pressure = m_pressure;
 }
 
+void DesignDriver::remember_if_closest_from_rest(const Eigen::VectorXd& rest, double avg_error_mm, int iteration) {
+  if (m_closest_from_rest && avg_error_mm >= m_closest_from_rest->avg_error_mm) return;
+  m_closest_from_rest = CheckedFromRest{unflatten(rest), avg_error_mm, iteration};
+}
+
 bool DesignDriver::restore_best(Eigen::VectorXd& rest) {
   // E_dist and the surface error mostly fall together; where they part, hand back the design with
   // the smallest average surface error seen (the log still shows every iterate).
@@ -401,6 +411,7 @@ DesignResult& DesignDriver::finish(DesignResult& result, const Eigen::VectorXd& 
   result.rest.vertices = unflatten(rest);
   result.time_s = design_clock_s() - m_start;
   result.surface_weight = m_objective.surface_weight();
+  result.closest_from_rest = m_closest_from_rest;
   const bool inflated = !result.log.empty();
   result.converged = inflated && m_final_equilibrium &&
                      (result.stop == DesignStop::Matched || result.stop == DesignStop::Optimal);

@@ -6,6 +6,7 @@
 /// current equilibrium (x, pressure) of it.
 #include <Eigen/Core>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -86,10 +87,10 @@ class DesignDriver {
   /// non-finite or beyond 1e10 times the force scale (PREDICTOR_RESIDUAL_LIMIT: a predictor carried past the
   /// linear range, where a stiffening rubber's forces explode).
   bool trial_start_in_range(const Eigen::VectorXd& rest, const Eigen::VectorXd& x, double pressure);
-  /// Starts inflating `rest` from rest as `balloon simulate` does, on a thread of its own (a check
-  /// still running is abandoned), and notes the current equilibrium, to which take_pending_shape_from_rest
-  /// compares the shape reached.
-  void start_shape_from_rest(const Eigen::VectorXd& rest);
+  /// Starts inflating `rest`, the rest shape of `iteration`, from rest as `balloon simulate` does, on a
+  /// thread of its own (a check still running is abandoned), and notes the current equilibrium, to which
+  /// take_pending_shape_from_rest compares the shape reached.
+  void start_shape_from_rest(const Eigen::VectorXd& rest, int iteration);
   /// Whether a check started by start_shape_from_rest awaits take_pending_shape_from_rest.
   bool shape_from_rest_pending() const { return m_from_rest.running(); }
   /// Waits for the check start_shape_from_rest started. Where it reached another shape than the
@@ -97,6 +98,7 @@ class DesignDriver {
   /// check's rest shape and goes on from the shape reached, placed on the target: `rest`, x and pressure
   /// are replaced and the best design seen is forgotten. True when it switched; false with nothing
   /// changed otherwise (no check pending, the check did not converge, or it reached the design's shape).
+  /// Either way a shape reached is a candidate for the result's closest_from_rest.
   bool take_pending_shape_from_rest(Eigen::VectorXd& rest);
   /// Whether the last Newton solve stopped on the cancel token or the deadline.
   bool stopped() const;
@@ -153,9 +155,16 @@ class DesignDriver {
   Eigen::VectorXd m_best_rest, m_best_x;
   double m_best_pressure = 0.0;
   bool m_final_equilibrium = true;
-  /// The check from rest running meanwhile: its rest shape, and the design's equilibrium when it started.
+  /// Keeps `rest` as the result's closest_from_rest when its shape from rest, `avg_error_mm` from the
+  /// target, is the closest seen.
+  void remember_if_closest_from_rest(const Eigen::VectorXd& rest, double avg_error_mm, int iteration);
+
+  /// The check from rest running meanwhile: its rest shape, its iteration, and the design's equilibrium
+  /// when it started.
   BackgroundInflation m_from_rest;
   Eigen::VectorXd m_from_rest_rest, m_from_rest_design_x;
+  int m_from_rest_iteration = 0;
+  std::optional<CheckedFromRest> m_closest_from_rest;
 };
 
 }  // namespace balloon

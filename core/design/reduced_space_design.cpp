@@ -356,7 +356,7 @@ class ReducedSpaceDesign {
         // Taken when ready instead, or with a check always running, the verdicts came later, more designs
         // ended on another shape, and fewer reached the target (README "Design on the corpus", session 61).
         if (m_sensitivity.volume_per_pressure() < 0.0 && !m_driver.shape_from_rest_pending()) {
-          m_driver.start_shape_from_rest(rest);
+          m_driver.start_shape_from_rest(rest, iteration);
           check_iteration = iteration;
         }
         objective = m_objective.value(rest, m_x);

@@ -6,15 +6,11 @@
 
 namespace balloon {
 
-namespace {
-
 std::string millimetres(double value_mm) {
   char text[32];
   std::snprintf(text, sizeof(text), "%.3g mm", value_mm);
   return text;
 }
-
-}  // namespace
 
 double deviation_from_design_mm(const Positions& shape, const Positions& design_inflated, const Faces& faces) {
   return SurfaceDistance(TriMesh{design_inflated, faces}).aligned_stats(shape, design_inflated).avg_mm;
@@ -43,6 +39,8 @@ RestInflationCheck check_inflation_from_rest(const TriMesh& rest, const Inflatio
   check.max_error_mm = error.max_mm;
   check.avg_error_rel = error.avg_rel;
   check.pressure_kpa = inflated.pressure_kpa;
+  check.shape = rigid_align_to(inflated.deformed, target_vertices);
+  check.residual_norm = inflated.residual_norm;
   check.unstable_modes = inflated.unstable_modes;
   check.deviation_mm = deviation_from_design_mm(inflated.deformed, design_inflated, rest.faces);
   check.another_shape = is_another_shape(*check.deviation_mm, design_avg_error_mm, error.bbox_diag_mm);

@@ -28,6 +28,10 @@ struct RestInflationCheck {
   /// ANOTHER_SHAPE_MIN_REL (0.5%) of the diagonal, so the design's error is not what the maker gets.
   bool another_shape = false;
   double time_s = 0.0;              ///< wall time of the check (s)
+  /// The shape reached (#V by 3, mm), rigidly aligned on the target as the error is measured, and its
+  /// force residual (N); empty unless converged.
+  Positions shape;
+  std::optional<double> residual_norm;
 };
 
 /// The check's own wall-time limit (s): the corpus's slowest forward inflations at 4,000 vertices take
@@ -38,6 +42,9 @@ constexpr double REST_INFLATION_CHECK_TIME_LIMIT_S = 60.0;
 /// 0.75 mm on a 150 mm balloon, about what a brushed layer of silicone varies by. (At 0.1%, the README's
 /// spot design, 0.087 mm from its target, was called another shape 0.11 mm from its own.)
 constexpr double ANOTHER_SHAPE_MIN_REL = 5e-3;
+
+/// A length as the checks' sentences give it ("1.23 mm").
+std::string millimetres(double value_mm);
 
 /// Mean distance (mm) of `shape`'s vertices, rigidly aligned on `design_inflated` (same connectivity
 /// `faces`), to that shape's surface: how far a shape reached from rest is from the design's.

@@ -105,7 +105,7 @@ TEST(DesignDriver, TheShapeReachedFromRestLeavesTheDesignsAloneAndReplacesAnothe
   EXPECT_FALSE(driver.take_pending_shape_from_rest(rest)) << "no check was started";
 
   // Silicone here has one equilibrium per volume: from rest it reaches the driver's own shape.
-  driver.start_shape_from_rest(rest);
+  driver.start_shape_from_rest(rest, 1);
   EXPECT_TRUE(driver.shape_from_rest_pending());
   EXPECT_FALSE(driver.take_pending_shape_from_rest(rest));
   EXPECT_FALSE(driver.shape_from_rest_pending());
@@ -117,7 +117,7 @@ TEST(DesignDriver, TheShapeReachedFromRestLeavesTheDesignsAloneAndReplacesAnothe
   // The check runs while the design goes on; its verdict concerns the rest shape it started from, to which
   // the design goes back.
   driver.x() = flat(design.target.vertices);
-  driver.start_shape_from_rest(rest);
+  driver.start_shape_from_rest(rest, 1);
   Eigen::VectorXd moved_on = 1.01 * rest;
   driver.x() = 1.01 * start_x;
   ASSERT_TRUE(driver.take_pending_shape_from_rest(moved_on));
@@ -128,12 +128,41 @@ TEST(DesignDriver, TheShapeReachedFromRestLeavesTheDesignsAloneAndReplacesAnothe
   EXPECT_FALSE(driver.restore_best_equilibrium(best)) << "the best design seen belonged to the other shape";
 }
 
+TEST(DesignDriver, TheClosestShapeFromRestIsTheStartUntilACheckFromRestComesCloser) {
+  // The start's inflation is the forward solver's path from rest, so the start is the first rest shape
+  // checked from rest; the result carries it for the hand-back of closest_from_rest.hpp.
+  EllipsoidDesign design(DesignMethod::Adjoint);
+  DesignDriver& driver = design.driver;
+  ASSERT_TRUE(design.inflate_start()) << design.result.message;
+  Eigen::VectorXd rest = design.start;
+  driver.finish(design.result, rest);
+  ASSERT_TRUE(design.result.closest_from_rest && design.result.baseline_avg_error_mm);
+  EXPECT_EQ(design.result.closest_from_rest->iteration, 0);
+  EXPECT_EQ(design.result.closest_from_rest->avg_error_mm, *design.result.baseline_avg_error_mm);
+  EXPECT_EQ(design.result.closest_from_rest->rest, design.driver.start().vertices);
+
+  // The known answer (the ellipsoid the target was inflated from), checked from rest at iteration 7,
+  // reaches the target itself: it becomes the closest, whichever shape the design then goes on from.
+  EllipsoidDesign again(DesignMethod::Adjoint);
+  ASSERT_TRUE(again.inflate_start()) << again.result.message;
+  TriMesh known = design_test::make_icosphere(2, 20.0);
+  known.vertices.col(0) *= 1.6;
+  rest = again.start;
+  again.driver.start_shape_from_rest(flat(known.vertices), 7);
+  again.driver.take_pending_shape_from_rest(rest);
+  again.driver.finish(again.result, rest);
+  ASSERT_TRUE(again.result.closest_from_rest);
+  EXPECT_EQ(again.result.closest_from_rest->iteration, 7);
+  EXPECT_LT(again.result.closest_from_rest->avg_error_mm, 1e-4);  // mm, on a 65 mm balloon
+  EXPECT_EQ(again.result.closest_from_rest->rest, known.vertices);
+}
+
 TEST(DesignDriver, ACheckFromRestStillRunningWhenTheDesignEndsIsAbandoned) {
   EllipsoidDesign design(DesignMethod::Adjoint);
   DesignDriver& driver = design.driver;
   ASSERT_TRUE(design.inflate_start()) << design.result.message;
   driver.x() = flat(design.target.vertices);  // a check would switch, were it taken
-  driver.start_shape_from_rest(design.start);
+  driver.start_shape_from_rest(design.start, 1);
   driver.finish(design.result, design.start);
   EXPECT_FALSE(driver.shape_from_rest_pending());
   Eigen::VectorXd rest = design.start;
