@@ -28,9 +28,9 @@ void hand_back_closest_from_rest(const TriMesh& target, const SurfaceDistance& t
   const std::string which = closest.iteration == 0 ? std::string("the start (the downscaled target)")
                                                    : "the design of iteration " + std::to_string(closest.iteration);
   const std::string final_verdict = final_is_farther ? "reaches " + millimetres(*final_check.avg_error_mm) + " from the target"
-                                                     : "finds no equilibrium (" + final_check.message + ")";
+                                                     : "finds no equilibrium (" + final_check.inflation_message + ")";
   const std::string handed_back = "inflated from rest, the last design " + final_verdict + ", so " + which +
-                                  ", " + millimetres(*again.avg_error_mm) + " from it from rest, is handed back";
+                                  " is handed back (" + millimetres(*again.avg_error_mm) + " from the target from rest)";
   if (result.converged) {
     // The criterion held for the last design on its own branch, not for the one handed back.
     result.converged = false;

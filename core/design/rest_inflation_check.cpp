@@ -29,6 +29,7 @@ RestInflationCheck check_inflation_from_rest(const TriMesh& rest, const Inflatio
   check.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   check.converged = inflated.converged;
   check.stop = inflated.stop;
+  check.inflation_message = inflated.message;
   if (!inflated.converged) {
     check.message = "inflated from rest, as balloon simulate does, it did not reach the design's volume: " +
                     inflated.message;

@@ -17,6 +17,7 @@ struct RestInflationCheck {
   bool converged = false;           ///< the inflation from rest reached the design's volume ratio
   InflationStop stop = InflationStop::NoEquilibrium;
   std::string message;              ///< the verdict as a sentence
+  std::string inflation_message;    ///< the forward solver's own words on how the inflation ended
   /// That shape against the target, aligned as the design's error is (mm); none unless converged.
   std::optional<double> avg_error_mm, max_error_mm, avg_error_rel;
   std::optional<double> pressure_kpa;  ///< its pressure (kPa); none unless converged

@@ -88,6 +88,29 @@ TEST(ClosestFromRest, AMatchedDesignThatGivesWayIsNoLongerCalledConverged) {
   EXPECT_FALSE(result.converged);
 }
 
+TEST(ClosestFromRest, AFinalDesignWithNoEquilibriumFromRestGivesWayToo) {
+  const TwoRestShapes shapes;
+  DesignResult result = shapes.result(shapes.sphere, shapes.stretched, 0.15);
+  // As where the final design's walls touch on its way from rest (the check's figures stay null).
+  RestInflationCheck no_equilibrium;
+  no_equilibrium.stop = InflationStop::PassesThroughItself;
+  no_equilibrium.inflation_message = "its walls touch";
+  result.from_rest = no_equilibrium;
+  hand_back_closest_from_rest(shapes.target, SurfaceDistance(shapes.target), shapes.options, result);
+  EXPECT_TRUE(result.rest.vertices.isApprox(shapes.stretched.vertices, 0.0));
+  ASSERT_TRUE(result.from_rest->converged && result.avg_error_mm);
+  EXPECT_NEAR(*result.avg_error_mm, 0.15, 0.05);
+  EXPECT_NE(result.message.find("finds no equilibrium (its walls touch)"), std::string::npos) << result.message;
+
+  // Where the check only ran out of time, nothing is known against the final design: it stays.
+  DesignResult timed_out = shapes.result(shapes.sphere, shapes.stretched, 0.15);
+  RestInflationCheck out_of_time;
+  out_of_time.stop = InflationStop::TimeLimit;
+  timed_out.from_rest = out_of_time;
+  hand_back_closest_from_rest(shapes.target, SurfaceDistance(shapes.target), shapes.options, timed_out);
+  EXPECT_TRUE(timed_out.rest.vertices.isApprox(shapes.sphere.vertices, 0.0));
+}
+
 TEST(ClosestFromRest, AFinalDesignCloserFromRestStays) {
   const TwoRestShapes shapes;
   // The checked shape's recorded error is the stretched sphere's from rest, above the final sphere's.
