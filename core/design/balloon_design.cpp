@@ -4,10 +4,10 @@
 #include <string>
 
 #include "design/augmented_lagrangian_design.hpp"
+#include "design/closest_from_rest.hpp"
 #include "design/design_driver.hpp"
 #include "design/multiresolution_design.hpp"
 #include "design/reduced_space_design.hpp"
-#include "design/closest_from_rest.hpp"
 #include "design/rest_inflation_check.hpp"
 #include "material/thin_sheet.hpp"
 #include "mesh/mesh_geometry.hpp"

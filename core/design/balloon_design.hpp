@@ -163,7 +163,7 @@ struct DesignResult {
   std::optional<RestInflationCheck> from_rest;
   /// Of the rest shapes checked from rest during the run, the one whose shape from rest came closest to
   /// the target; none without an inflated start. Where the final design inflates from rest farther
-  /// from the target, or finds no equilibrium there, this one is handed back (balloon_design.cpp).
+  /// from the target, or finds no equilibrium there, this one is handed back (closest_from_rest.hpp).
   std::optional<CheckedFromRest> closest_from_rest;
 };
 
