@@ -33,10 +33,13 @@ void hand_back_closest_from_rest(const TriMesh& target, const SurfaceDistance& t
                                   " is handed back (" + millimetres(*again.avg_error_mm) + " from the target from rest)";
   if (result.converged) {
     // The criterion held for the last design on its own branch, not for the one handed back.
+    result.message = "stalled: the last design was " + design_stop_name(result.stop) +
+                     " on the branch the design followed (" + result.message + "), but " + handed_back;
     result.converged = false;
     result.stop = DesignStop::Stalled;
+  } else {
+    result.message += "; " + handed_back;
   }
-  result.message += "; " + handed_back;
   result.rest.vertices = closest.rest;
   result.inflated = again.shape;
   result.pressure_kpa = again.pressure_kpa;

@@ -86,6 +86,8 @@ TEST(ClosestFromRest, AMatchedDesignThatGivesWayIsNoLongerCalledConverged) {
   EXPECT_TRUE(result.rest.vertices.isApprox(shapes.sphere.vertices, 0.0));
   EXPECT_EQ(result.stop, DesignStop::Stalled);
   EXPECT_FALSE(result.converged);
+  EXPECT_EQ(result.message.rfind("stalled: the last design was matched on the branch the design followed", 0), 0u)
+      << result.message;
 }
 
 TEST(ClosestFromRest, AFinalDesignWithNoEquilibriumFromRestGivesWayToo) {
