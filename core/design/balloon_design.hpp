@@ -118,8 +118,8 @@ struct CoarseStage {
 };
 
 /// A rest shape of the run whose inflation from rest was measured along the way: the start (its
-/// inflation is the forward solver's volume path from rest) and, past a pressure maximum, the rest
-/// shapes checked from rest as the design went (DesignDriver::take_pending_shape_from_rest).
+/// inflation is the forward solver's volume path from rest) and the rest shapes checked from rest at each
+/// growth of the surface weight (DesignDriver::take_pending_shape_from_rest).
 struct CheckedFromRest {
   Positions rest;               ///< #V by 3 (mm)
   double avg_error_mm = 0.0;    ///< its shape from rest against the target (mm), aligned as the error is
