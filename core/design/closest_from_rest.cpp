@@ -7,6 +7,13 @@
 #include "mesh/mesh_geometry.hpp"
 
 namespace balloon {
+namespace {
+
+/// How much farther from the target, inflated from rest, the final design must end than the closest
+/// candidate for that candidate to be handed back: a percent, well above the checks' own noise.
+constexpr double CLEARLY_FARTHER = 1.01;
+
+}  // namespace
 
 void hand_back_closest_from_rest(const TriMesh& target, const SurfaceDistance& target_surface,
                                  InflationOptions inflation, DesignResult& result) {
@@ -15,7 +22,12 @@ void hand_back_closest_from_rest(const TriMesh& target, const SurfaceDistance& t
   const CheckedFromRest& closest = *result.closest_from_rest;
   const bool final_has_no_equilibrium = !final_check.converged && (final_check.stop == InflationStop::NoEquilibrium ||
                                                                    final_check.stop == InflationStop::PassesThroughItself);
-  const bool final_is_farther = final_check.converged && *final_check.avg_error_mm > closest.avg_error_mm;
+  // The final design may be that candidate itself (a design matched at its start), whose two checks differ
+  // by rounding only: a 642-vertex sphere matched after 0 iterations was reported stalled, its start
+  // "handed back" for 0.0035149514115865375 mm against 0.0035149514115865063 mm.
+  if (closest.rest == result.rest.vertices) return;
+  const bool final_is_farther =
+      final_check.converged && *final_check.avg_error_mm > CLEARLY_FARTHER * closest.avg_error_mm;
   if (!final_has_no_equilibrium && !final_is_farther) return;
   const TriMesh closest_rest{closest.rest, target.faces};
   inflation.volume_ratio = enclosed_volume(target.vertices, target.faces) / enclosed_volume(closest.rest, target.faces);

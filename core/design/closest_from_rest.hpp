@@ -6,8 +6,9 @@
 
 namespace balloon {
 
-/// Where the final design, inflated from rest as a maker inflates it, ends farther from the target than
-/// a rest shape checked from rest during the run (the start, or an earlier design), or finds no
+/// Where the final design, inflated from rest as a maker inflates it, ends clearly farther (more than 1%)
+/// from the target than another rest shape checked from rest during the run (the start, or an earlier
+/// design), or finds no
 /// equilibrium there, that rest shape is checked again the same way and, where it still does better, is
 /// handed back with the shape it reaches: what the maker gets is never worse than a design the run
 /// already knew. (Latex bunny, x27, 20 s: the last design took another shape from rest at

@@ -137,5 +137,28 @@ TEST(ClosestFromRest, AHandedBackShapeMustStillDoBetterWhenCheckedAgain) {
   EXPECT_EQ(result.message, "time limit reached");
 }
 
+TEST(ClosestFromRest, ADesignMatchedAtItsStartIsNotHandedItsOwnStartBack) {
+  const TwoRestShapes shapes;
+  // The final design is the start itself (matched after 0 iterations); its two checks from rest differ
+  // in the last digits only.
+  DesignResult result = shapes.result(shapes.sphere, shapes.sphere, 0.0);
+  result.stop = DesignStop::Matched;
+  result.converged = true;
+  result.message = "matched";
+  result.closest_from_rest->avg_error_mm = *result.from_rest->avg_error_mm * (1.0 - 1e-14);
+  hand_back_closest_from_rest(shapes.target, SurfaceDistance(shapes.target), shapes.options, result);
+  EXPECT_EQ(result.stop, DesignStop::Matched);
+  EXPECT_TRUE(result.converged);
+  EXPECT_EQ(result.message, "matched");
+  EXPECT_TRUE(result.distance_energy);
+
+  // Nor does another rest shape that did better by less than a percent replace it.
+  DesignResult close_call = shapes.result(shapes.stretched, shapes.sphere, 0.0);
+  close_call.closest_from_rest->avg_error_mm = *close_call.from_rest->avg_error_mm * 0.995;
+  hand_back_closest_from_rest(shapes.target, SurfaceDistance(shapes.target), shapes.options, close_call);
+  EXPECT_TRUE(close_call.rest.vertices.isApprox(shapes.stretched.vertices, 0.0));
+  EXPECT_EQ(close_call.message, "time limit reached");
+}
+
 }  // namespace
 }  // namespace balloon
