@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "design/augmented_lagrangian_design.hpp"
 #include "design/closest_from_rest.hpp"
@@ -10,6 +11,7 @@
 #include "design/reduced_space_design.hpp"
 #include "design/rest_inflation_check.hpp"
 #include "material/thin_sheet.hpp"
+#include "mesh/centred_frame.hpp"
 #include "mesh/mesh_geometry.hpp"
 
 namespace balloon {
@@ -112,9 +114,11 @@ double design_start_scale(const DesignOptions& options) {
   return options.scale > 0 ? options.scale : std::cbrt(1.0 / options.volume_ratio);
 }
 
-/// The entry point: refuse what cannot be designed, then set up the run and hand it to the chosen
-/// optimizer (reduced_space_design.hpp, augmented_lagrangian_design.hpp).
-DesignResult design_balloon(const TriMesh& target, const DesignOptions& options) {
+namespace {
+
+/// The design in the target's centred frame (mesh/centred_frame.hpp): refuse what cannot be designed,
+/// then set up the run and hand it to the chosen optimizer.
+DesignResult design_centred(const TriMesh& target, const DesignOptions& options) {
   if (auto problem = options_problem(target, options); !problem.empty()) {
     DesignResult result;
     result.method = options.method;
@@ -126,6 +130,38 @@ DesignResult design_balloon(const TriMesh& target, const DesignOptions& options)
   }
   DesignResult result = run_optimizer(target, options);
   if (options.check_from_rest) add_rest_inflation_check(target, options, result);
+  return result;
+}
+
+/// Progress whose shapes reach the caller in its own frame.
+ProgressCallback in_caller_frame(const CentredFrame& frame, ProgressCallback progress) {
+  if (!progress) return progress;
+  return [frame, progress = std::move(progress)](const ProgressEvent& event) {
+    ProgressEvent moved = event;
+    Positions shape, rest_shape;
+    if (event.shape) moved.shape = &(shape = frame.caller(*event.shape));
+    if (event.rest_shape) moved.rest_shape = &(rest_shape = frame.caller(*event.rest_shape));
+    progress(moved);
+  };
+}
+
+}  // namespace
+
+/// The entry point (reduced_space_design.hpp, augmented_lagrangian_design.hpp): designed about the
+/// target's bounding-box centre, every position handed back where the caller's target stands.
+DesignResult design_balloon(const TriMesh& caller_target, const DesignOptions& caller_options) {
+  const CentredFrame frame(caller_target.vertices);
+  const TriMesh target{frame.centred(caller_target.vertices), caller_target.faces};
+  DesignOptions options = caller_options;
+  options.initial_rest = frame.centred(caller_options.initial_rest);
+  if (options.resume) options.resume->rest = frame.centred(options.resume->rest);
+  options.progress = in_caller_frame(frame, caller_options.progress);
+
+  DesignResult result = design_centred(target, options);
+  result.rest.vertices = frame.caller(result.rest.vertices);
+  result.inflated = frame.caller(result.inflated);
+  if (result.from_rest) result.from_rest->shape = frame.caller(result.from_rest->shape);
+  if (result.closest_from_rest) result.closest_from_rest->rest = frame.caller(result.closest_from_rest->rest);
   return result;
 }
 

@@ -13,11 +13,15 @@
 namespace balloon {
 
 double enclosed_volume(const Positions& vertices, const Faces& faces) {
+  if (vertices.rows() == 0) return 0.0;
+  // Tetrahedra on a vertex of the mesh instead of the origin: the same volume for a closed surface, with
+  // products of the mesh's size rather than of its distance from the origin (mesh/centred_frame.hpp).
+  const Eigen::RowVector3d o = vertices.row(0);
   double six_volume = 0.0;
   for (Eigen::Index f = 0; f < faces.rows(); ++f) {
-    const Eigen::RowVector3d a = vertices.row(faces(f, 0));
-    const Eigen::RowVector3d b = vertices.row(faces(f, 1));
-    const Eigen::RowVector3d c = vertices.row(faces(f, 2));
+    const Eigen::RowVector3d a = vertices.row(faces(f, 0)) - o;
+    const Eigen::RowVector3d b = vertices.row(faces(f, 1)) - o;
+    const Eigen::RowVector3d c = vertices.row(faces(f, 2)) - o;
     six_volume += a.dot(b.cross(c));
   }
   return six_volume / 6.0;

@@ -9,8 +9,9 @@
 namespace balloon {
 
 /// Signed volume (mm^3) enclosed by the triangles F (#F x 3) over positions V (#V x 3, mm), by the
-/// divergence theorem: sum over faces of a . (b x c) / 6. Positive for a closed mesh oriented outwards;
-/// for an open mesh it depends on the origin.
+/// divergence theorem: sum over faces of a . (b x c) / 6, with a, b, c taken from the first vertex (the
+/// products stay at the mesh's size wherever it stands). Positive for a closed mesh oriented outwards;
+/// for an open mesh it depends on that reference point.
 double enclosed_volume(const Positions& vertices, const Faces& faces);
 
 /// Total area (mm^2) of the triangles F (#F x 3) over positions V (#V x 3, mm).

@@ -7,6 +7,7 @@
 
 #include "material/thin_sheet.hpp"
 #include "mesh/cap_sliver_flips.hpp"
+#include "mesh/centred_frame.hpp"
 #include "mesh/mesh_geometry.hpp"
 #include "solve/inflation_run.hpp"
 #include "solve/quantity_text.hpp"
@@ -41,9 +42,11 @@ std::string options_problem(const TriMesh& rest, const InflationOptions& options
   return "";
 }
 
-/// The mesh and options a run simulates: the rest mesh with its cap slivers flipped away (same vertices,
-/// so its deformed positions are the caller's), a flipped pair taking the mean of its two thicknesses.
+/// The mesh and options a run simulates: the rest mesh moved to its centred frame (positions go back to
+/// the caller's frame through `frame`) with its cap slivers flipped away (same vertices), a flipped pair
+/// taking the mean of its two thicknesses.
 struct SimulationMesh {
+  CentredFrame frame;
   TriMesh rest;
   InflationOptions options;
   int flipped_cap_slivers = 0;
@@ -51,7 +54,8 @@ struct SimulationMesh {
 
 SimulationMesh simulation_mesh(const TriMesh& rest, const InflationOptions& options) {
   CapSliverFlips flips = flip_cap_slivers(rest);
-  SimulationMesh simulated{TriMesh{rest.vertices, std::move(flips.faces)}, options,
+  const CentredFrame frame(rest.vertices);
+  SimulationMesh simulated{frame, TriMesh{frame.centred(rest.vertices), std::move(flips.faces)}, options,
                            static_cast<int>(flips.flipped_pairs.size())};
   std::vector<double>& thickness = simulated.options.element_thickness_mm;
   if (!thickness.empty())
@@ -99,13 +103,14 @@ const char* inflation_stop_word(InflationStop stop) {
 
 struct InflationPath::Impl {
   Impl(const TriMesh& rest_mesh, const InflationOptions& path_options)
-      : problem(options_problem(rest_mesh, path_options)) {
+      : simulated{CentredFrame(rest_mesh.vertices), rest_mesh, path_options},
+        problem(options_problem(rest_mesh, path_options)) {
     if (problem.empty()) {
       simulated = simulation_mesh(rest_mesh, path_options);
       run = std::make_unique<InflationRun>(simulated.rest, simulated.options);
       run->use_path_predictor();
     } else {
-      simulated.rest = rest_mesh;
+      simulated.rest.vertices = simulated.frame.centred(rest_mesh.vertices);  // as every position held here
     }
   }
   SimulationMesh simulated;  // the run keeps references to its mesh and options
@@ -121,7 +126,9 @@ InflationPath::InflationPath(const TriMesh& rest, const InflationOptions& option
   // A curve reports every point it reaches; whether one passes through itself is not judged along it.
   checked.reject_self_intersection = false;
   m = std::make_unique<Impl>(rest, checked);
-  if (m->run) m->problem = m->run->start(initial_guess);
+  if (!m->run) return;
+  const Positions guess = initial_guess ? m->simulated.frame.centred(*initial_guess) : Positions();
+  m->problem = m->run->start(initial_guess ? &guess : nullptr);
 }
 
 InflationPath::~InflationPath() = default;
@@ -135,10 +142,11 @@ InflationResult InflationPath::advance(InflationControl control, double target) 
     InflationResult result;
     result.stop = InflationStop::InvalidInput;
     result.message = problem;
-    result.deformed = m->simulated.rest.vertices;
+    result.deformed = m->simulated.frame.caller(m->simulated.rest.vertices);
     return result;
   }
   InflationResult result = m->run->advance(control, target);
+  result.deformed = m->simulated.frame.caller(result.deformed);
   result.flipped_cap_slivers = m->simulated.flipped_cap_slivers;
   return result;
 }
@@ -191,7 +199,9 @@ InflationResult inflate(const TriMesh& rest, const InflationOptions& options, co
     return result;
   }
   const SimulationMesh simulated = simulation_mesh(rest, options);
-  InflationResult result = inflate_simulated(simulated, initial_guess);
+  const Positions guess = initial_guess ? simulated.frame.centred(*initial_guess) : Positions();
+  InflationResult result = inflate_simulated(simulated, initial_guess ? &guess : nullptr);
+  result.deformed = simulated.frame.caller(result.deformed);
   result.flipped_cap_slivers = simulated.flipped_cap_slivers;
   return result;
 }

@@ -141,5 +141,15 @@ TEST(MeshEdgeTopology, RejectsNonManifoldEdgesAndBadIndices) {
   EXPECT_THROW(build_edge_topology(mesh.faces, mesh.vertex_count() - 1), std::invalid_argument);
 }
 
+TEST(MeshGeometry, AMeshFarFromTheOriginEnclosesTheVolumeItDoesAtTheOrigin) {
+  const TriMesh sphere = make_icosphere(20.0, 3);
+  const double at_origin = enclosed_volume(sphere.vertices, sphere.faces);
+  for (double offset : {1e5, 1e7, 1e9}) {
+    const Positions far = sphere.vertices.rowwise() + Eigen::RowVector3d(offset, -offset, offset);
+    // Tetrahedra on the origin summed products near offset^3 (1e27 mm^3 at 1e9) to a volume of 3.3e4.
+    EXPECT_NEAR(enclosed_volume(far, sphere.faces), at_origin, 1e-12 * offset / 20.0 * at_origin) << offset;
+  }
+}
+
 }  // namespace
 }  // namespace balloon

@@ -884,5 +884,17 @@ TEST(MeshIoHostile, LimitsHoldForEveryFormat) {
   EXPECT_FALSE(is_over_limit_error("face 12 has too many neighbours"));
 }
 
+TEST(MeshIo, AnObjFarFromTheOriginKeepsItsVerticesToAHundredMillionthOfItsSize) {
+  const TriMesh sphere = make_icosphere(20.0, 1);
+  for (double offset : {0.0, 1e5, 1e9}) {
+    TriMesh far = sphere;
+    far.vertices.rowwise() += Eigen::RowVector3d(offset, 2.0 * offset, -offset);
+    const Result<TriMesh> back = read_mesh_from_memory(write_mesh_to_memory(far, "obj"), "obj");
+    ASSERT_TRUE(back) << back.error();
+    // 9 significant digits had written every x of the sphere at 1e12 mm as 1e+12.
+    EXPECT_LT((back->vertices - far.vertices).cwiseAbs().maxCoeff(), 1e-8 * 40.0) << offset;
+  }
+}
+
 }  // namespace
 }  // namespace balloon

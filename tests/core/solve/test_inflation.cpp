@@ -682,5 +682,33 @@ TEST(Inflation, APathThatStrugglesPastItsWallsTouchingEndsThereWithThatReason) {
   EXPECT_NE(result.message.find("passes through itself"), std::string::npos) << result.message;
 }
 
+TEST(Inflation, ABalloonFarFromTheOriginInflatesAsItDoesAtTheOrigin) {
+  // 1 km away its enclosed volume, summed from the origin, was wrong by more than itself: the path never
+  // left volume ratio 1 ("Newton iteration limit reached"). Solved about its own centre, it is the same
+  // balloon, handed back where it stands.
+  const TriMesh sphere = make_icosphere(20.0, 3);
+  InflationOptions options;
+  options.material = *parse_material_spec("silicone");
+  options.volume_ratio = 4.0;
+  const InflationResult at_origin = inflate(sphere, options);
+  ASSERT_TRUE(at_origin.converged) << at_origin.message;
+  const Eigen::RowVector3d offset(1e6, -1e6, 1e6);
+  const TriMesh far{sphere.vertices.rowwise() + offset, sphere.faces};
+  const InflationResult moved = inflate(far, options);
+  ASSERT_TRUE(moved.converged) << moved.message;
+  EXPECT_EQ(moved.newton_iterations, at_origin.newton_iterations);
+  EXPECT_NEAR(moved.volume_ratio, 4.0, 1e-8);
+  EXPECT_NEAR(moved.pressure_kpa, at_origin.pressure_kpa, 1e-9 * at_origin.pressure_kpa);
+  const Positions expected = at_origin.deformed.rowwise() + offset;
+  EXPECT_LT((moved.deformed - expected).cwiseAbs().maxCoeff(), 1e-6);
+
+  // A path that goes on from a given shape takes it in the caller's frame too.
+  InflationPath path(far, options, &moved.deformed);
+  const InflationResult further = path.advance(InflationControl::VolumeRatio, 5.0);
+  ASSERT_TRUE(further.converged) << further.message;
+  EXPECT_NEAR(further.volume_ratio, 5.0, 1e-8);
+  EXPECT_LT((centroid(further.deformed) - centroid(far.vertices)).norm(), 1e-3);
+}
+
 }  // namespace
 }  // namespace balloon
