@@ -5,10 +5,12 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <utility>
 
 #include "design/rest_inflation_check.hpp"
 #include "mesh/mesh_geometry.hpp"
 #include "solve/inflation.hpp"
+#include "solve/inflation_run.hpp"
 #include "solve/rigid_modes.hpp"
 
 namespace balloon {
@@ -112,7 +114,7 @@ bool DesignDriver::inflate_start(const Eigen::VectorXd& rest, DesignResult& resu
   result.baseline_max_error_mm = baseline.max_mm;
   record(result, 0, baseline, rest);
   remember_if_best(rest, baseline.avg_mm);
-  remember_if_closest_from_rest(rest, baseline.avg_mm, 0);
+  remember_if_closest_from_rest(rest, unflatten(m_x), 0);
   debug_time("baseline error");
   return true;
 }
@@ -281,6 +283,10 @@ bool DesignDriver::settle(const Eigen::VectorXd& rest) {
 }
 
 void DesignDriver::start_shape_from_rest(const Eigen::VectorXd& rest, int iteration) {
+  m_before_check.clear();
+  for (Iterate& iterate : m_since_check)
+    if (iterate.iteration < iteration) m_before_check.push_back(std::move(iterate));
+  m_since_check.clear();
   m_from_rest_rest = rest;
   m_from_rest_iteration = iteration;
   m_from_rest_design_x = m_x;
@@ -297,13 +303,12 @@ bool DesignDriver::take_pending_shape_from_rest(Eigen::VectorXd& rest) {
   const Positions design_x = unflatten(m_from_rest_design_x);
   const double deviation = deviation_from_design_mm(inflated.deformed, design_x, m_model.faces());
   const double design_error = m_objective.surface().aligned_stats(design_x, m_target.vertices).avg_mm;
-  remember_if_closest_from_rest(m_from_rest_rest,
-                                m_objective.surface().aligned_stats(inflated.deformed, m_target.vertices).avg_mm,
-                                m_from_rest_iteration);
+  remember_if_closest_from_rest(m_from_rest_rest, inflated.deformed, m_from_rest_iteration);
   if (design_debug())
     std::fprintf(stderr, "  from rest: %.3g mm from the design's shape (its error %.3g mm), %.4g kPa\n", deviation,
                  design_error, inflated.pressure_kpa);
   if (!is_another_shape(deviation, design_error, m_objective.surface().bbox_diagonal_mm())) return false;
+  check_iterates_before_the_pending_one();
   m_model.set_rest_positions(unflatten(m_from_rest_rest));
   if (inflated.bending && !m_model.bending()) set_bending(true);
   Eigen::VectorXd x = flat(inflated.deformed);
@@ -316,7 +321,31 @@ bool DesignDriver::take_pending_shape_from_rest(Eigen::VectorXd& rest) {
   m_x = flat(rigid_align_to(unflatten(x), m_target.vertices));
   m_pressure = pressure;
   m_best_error = std::numeric_limits<double>::infinity();
+  m_since_check.clear();  // beside the check, on the branch left behind
   return true;
+}
+
+void DesignDriver::check_iterates_before_the_pending_one() {
+  // The check at a growth sees one rest shape in four. Where it finds another shape, the design's branch
+  // left the one reached from rest somewhere since the check before, and the iterates in between that
+  // still reach their own shape from rest are candidates the hand-back (closest_from_rest.hpp) had not
+  // seen: the generated latex tori reached 2.5-3.0 mm on their branch, then the check of the 4th or 5th
+  // iteration found another shape, and the start (5.1-5.7 mm) was what came back.
+  const std::vector<Iterate> iterates = std::move(m_before_check);
+  m_before_check.clear();
+  for (auto iterate = iterates.rbegin(); iterate != iterates.rend(); ++iterate) {
+    if (m_settings.deadline_s > 0 && design_clock_s() >= m_settings.deadline_s) return;
+    if (m_options.cancel && m_options.cancel->cancelled()) return;
+    const InflationResult inflated =
+        inflate(TriMesh{unflatten(iterate->rest), m_model.faces()}, inflation_from_rest(iterate->rest));
+    if (!inflated.converged) continue;
+    remember_if_closest_from_rest(iterate->rest, inflated.deformed, iterate->iteration);
+    const double deviation = deviation_from_design_mm(inflated.deformed, unflatten(iterate->x), m_model.faces());
+    if (design_debug())
+      std::fprintf(stderr, "  iteration %d from rest: %.3g mm from its design's shape (its error %.3g mm)\n",
+                   iterate->iteration, deviation, iterate->avg_error_mm);
+    if (!is_another_shape(deviation, iterate->avg_error_mm, m_objective.surface().bbox_diagonal_mm())) return;
+  }
 }
 
 bool DesignDriver::trial_start_in_range(const Eigen::VectorXd& rest, const Eigen::VectorXd& x, double pressure) {
@@ -354,6 +383,12 @@ void DesignDriver::record(DesignResult& result, int iteration, const SurfaceDist
   sample.max_error_mm = stats.max_mm;
   sample.residual_norm = m_last_report.residual_norm;
   result.log.push_back(sample);
+  if (iteration > 0) {
+    m_since_check.push_back(Iterate{iteration, rest, m_x, stats.avg_mm});
+    // A check starts every few iterations (DesignOptions::surface_growth_iterations); the ALM never starts one.
+    while (static_cast<int>(m_since_check.size()) > std::max(1, m_options.surface_growth_iterations))
+      m_since_check.pop_front();
+  }
   if (!m_options.progress) return;
   ProgressEvent event;
   event.phase = iteration == 0 ? "start" : "design";
@@ -382,9 +417,15 @@ void DesignDriver::remember_if_best(const Eigen::VectorXd& rest, double avg_erro
   m_best_pressure = m_pressure;
 }
 
-void DesignDriver::remember_if_closest_from_rest(const Eigen::VectorXd& rest, double avg_error_mm, int iteration) {
+void DesignDriver::remember_if_closest_from_rest(const Eigen::VectorXd& rest, const Positions& reached, int iteration) {
+  const double avg_error_mm = m_objective.surface().aligned_stats(reached, m_target.vertices).avg_mm;
   if (m_closest_from_rest && avg_error_mm >= m_closest_from_rest->avg_error_mm) return;
-  m_closest_from_rest = CheckedFromRest{unflatten(rest), avg_error_mm, iteration};
+  // The checks from rest let a shape pass through itself (the design moves away from it), but no maker
+  // gets that balloon: the hand-back checks its candidate as balloon simulate does, refused it, and gave
+  // nothing back, not even the start that had come next (generated latex double torus, seed 64).
+  const TriMesh rest_mesh{unflatten(rest), m_model.faces()};
+  if (passes_through_itself(rest_mesh, reached)) return;
+  m_closest_from_rest = CheckedFromRest{rest_mesh.vertices, avg_error_mm, iteration};
 }
 
 bool DesignDriver::restore_best(Eigen::VectorXd& rest) {

@@ -5,6 +5,7 @@
 /// (reduced_space_design.hpp, augmented_lagrangian_design.hpp) move the rest shape; the driver keeps the
 /// current equilibrium (x, pressure) of it.
 #include <Eigen/Core>
+#include <deque>
 #include <limits>
 #include <optional>
 #include <string>
@@ -98,7 +99,10 @@ class DesignDriver {
   /// check's rest shape and goes on from the shape reached, placed on the target: `rest`, x and pressure
   /// are replaced and the best design seen is forgotten. True when it switched; false with nothing
   /// changed otherwise (no check pending, the check did not converge, or it reached the design's shape).
-  /// Either way a shape reached is a candidate for the result's closest_from_rest.
+  /// Either way a shape reached is a candidate for the result's closest_from_rest. Before it switches,
+  /// the iterates recorded between the previous check and this one are inflated from rest too, latest
+  /// first, down to the first that reaches its own design's shape: candidates on the design's branch,
+  /// which the check of the growth alone had passed over.
   bool take_pending_shape_from_rest(Eigen::VectorXd& rest);
   /// Whether the last Newton solve stopped on the cancel token or the deadline.
   bool stopped() const;
@@ -111,6 +115,9 @@ class DesignDriver {
   void record(DesignResult& result, int iteration, const SurfaceDistanceStats& stats, const Eigen::VectorXd& rest);
   /// Keeps (rest, x, pressure) when `avg_error` is the smallest seen.
   void remember_if_best(const Eigen::VectorXd& rest, double avg_error);
+  /// Keeps `rest` as the result's closest_from_rest when the shape it reached from rest, `reached`, is the
+  /// closest to the target seen and does not pass through itself.
+  void remember_if_closest_from_rest(const Eigen::VectorXd& rest, const Positions& reached, int iteration);
   /// Goes back to the best design seen when its average surface error is below the current one's; true
   /// when it did.
   bool restore_best(Eigen::VectorXd& rest);
@@ -155,9 +162,10 @@ class DesignDriver {
   Eigen::VectorXd m_best_rest, m_best_x;
   double m_best_pressure = 0.0;
   bool m_final_equilibrium = true;
-  /// Keeps `rest` as the result's closest_from_rest when its shape from rest, `avg_error_mm` from the
-  /// target, is the closest seen.
-  void remember_if_closest_from_rest(const Eigen::VectorXd& rest, double avg_error_mm, int iteration);
+
+  /// Inflates the iterates recorded before the pending check from rest, latest first, until one reaches
+  /// its own design's shape (take_pending_shape_from_rest), within the budget.
+  void check_iterates_before_the_pending_one();
 
   /// The check from rest running meanwhile: its rest shape, its iteration, and the design's equilibrium
   /// when it started.
@@ -165,6 +173,14 @@ class DesignDriver {
   Eigen::VectorXd m_from_rest_rest, m_from_rest_design_x;
   int m_from_rest_iteration = 0;
   std::optional<CheckedFromRest> m_closest_from_rest;
+  /// A design iterate not checked from rest: its rest shape, its equilibrium and that one's error (mm).
+  struct Iterate {
+    int iteration = 0;
+    Eigen::VectorXd rest, x;
+    double avg_error_mm = 0.0;
+  };
+  std::deque<Iterate> m_since_check;   ///< recorded since the last check started (the latest few)
+  std::vector<Iterate> m_before_check;  ///< recorded between the check before and the pending one
 };
 
 }  // namespace balloon

@@ -157,6 +157,70 @@ TEST(DesignDriver, TheClosestShapeFromRestIsTheStartUntilACheckFromRestComesClos
   EXPECT_EQ(again.result.closest_from_rest->rest, known.vertices);
 }
 
+TEST(DesignDriver, WhereACheckFromRestFindsAnotherShapeTheIteratesBeforeItAreCheckedToo) {
+  // Iteration 1's rest shape is the known answer, whose shape from rest is the target, as its design's
+  // is. Iteration 2 goes back to the start but, as on a branch inflation from rest does not reach, its
+  // design's shape is the target too: its check, started at iteration 2 as at a growth, finds another
+  // shape (the start's, 1.4 mm away on average). Iteration 1, which the check passed over, is then
+  // checked as well and becomes the closest candidate.
+  EllipsoidDesign design(DesignMethod::Adjoint);
+  DesignDriver& driver = design.driver;
+  ASSERT_TRUE(design.inflate_start()) << design.result.message;
+  TriMesh known = design_test::make_icosphere(2, 20.0);
+  known.vertices.col(0) *= 1.6;
+  const Eigen::VectorXd known_rest = flat(known.vertices);
+  driver.x() = flat(design.target.vertices);
+  SurfaceDistanceStats on_target;  // the design's own error on its branch: none
+  driver.record(design.result, 1, on_target, known_rest);
+  driver.record(design.result, 2, on_target, design.start);
+  driver.start_shape_from_rest(design.start, 2);
+  Eigen::VectorXd rest = design.start;
+  EXPECT_TRUE(driver.take_pending_shape_from_rest(rest)) << "iteration 2 reaches another shape from rest";
+  driver.finish(design.result, rest);
+  ASSERT_TRUE(design.result.closest_from_rest);
+  EXPECT_EQ(design.result.closest_from_rest->iteration, 1);
+  EXPECT_LT(design.result.closest_from_rest->avg_error_mm, 1e-4);  // mm, on a 65 mm balloon
+  EXPECT_EQ(design.result.closest_from_rest->rest, known.vertices);
+
+  // Where the check reaches the design's own shape (the start's, from the start), the iterates before it
+  // are not inflated: the known answer recorded at iteration 1 never becomes a candidate.
+  EllipsoidDesign agreeing(DesignMethod::Adjoint);
+  ASSERT_TRUE(agreeing.inflate_start()) << agreeing.result.message;
+  agreeing.driver.record(agreeing.result, 1, on_target, known_rest);
+  agreeing.driver.start_shape_from_rest(agreeing.start, 2);
+  rest = agreeing.start;
+  EXPECT_FALSE(agreeing.driver.take_pending_shape_from_rest(rest));
+  agreeing.driver.finish(agreeing.result, rest);
+  ASSERT_TRUE(agreeing.result.closest_from_rest && agreeing.result.baseline_avg_error_mm);
+  EXPECT_NE(agreeing.result.closest_from_rest->iteration, 1);
+  EXPECT_NEAR(agreeing.result.closest_from_rest->avg_error_mm, *agreeing.result.baseline_avg_error_mm, 1e-6);
+}
+
+TEST(DesignDriver, AShapeFromRestThatPassesThroughItselfIsNoCandidate) {
+  // The target with one vertex pushed through the opposite wall: 0.1 mm from the target on average, far
+  // closer than the start's shape from rest, but no balloon a maker gets; the start stays the candidate.
+  EllipsoidDesign design(DesignMethod::Adjoint);
+  DesignDriver& driver = design.driver;
+  ASSERT_TRUE(design.inflate_start()) << design.result.message;
+  Positions folded = design.target.vertices;
+  const Eigen::Index top = [&] { Eigen::Index v; folded.col(2).maxCoeff(&v); return v; }();
+  folded(top, 2) = folded.col(2).minCoeff() - 5.0;
+  driver.remember_if_closest_from_rest(flat(design.target.vertices), folded, 3);
+  Eigen::VectorXd rest = design.start;
+  driver.finish(design.result, rest);
+  ASSERT_TRUE(design.result.closest_from_rest && design.result.baseline_avg_error_mm);
+  EXPECT_EQ(design.result.closest_from_rest->iteration, 0);
+
+  // The same shape without the fold is one.
+  EllipsoidDesign again(DesignMethod::Adjoint);
+  ASSERT_TRUE(again.inflate_start()) << again.result.message;
+  again.driver.remember_if_closest_from_rest(flat(again.target.vertices), again.target.vertices, 3);
+  rest = again.start;
+  again.driver.finish(again.result, rest);
+  ASSERT_TRUE(again.result.closest_from_rest);
+  EXPECT_EQ(again.result.closest_from_rest->iteration, 3);
+}
+
 TEST(DesignDriver, ACheckFromRestStillRunningWhenTheDesignEndsIsAbandoned) {
   EllipsoidDesign design(DesignMethod::Adjoint);
   DesignDriver& driver = design.driver;
