@@ -100,9 +100,9 @@ class DesignDriver {
   /// are replaced and the best design seen is forgotten. True when it switched; false with nothing
   /// changed otherwise (no check pending, the check did not converge, or it reached the design's shape).
   /// Either way a shape reached is a candidate for the result's closest_from_rest. Before it switches,
-  /// the iterates recorded between the previous check and this one are inflated from rest too, latest
-  /// first, down to the first that reaches its own design's shape: candidates on the design's branch,
-  /// which the check of the growth alone had passed over.
+  /// the iterates recorded between the previous check and this one are inflated from rest too, earliest
+  /// first, up to the first that reaches another shape than its design's: candidates on the design's
+  /// branch, which the check of the growth alone had passed over.
   bool take_pending_shape_from_rest(Eigen::VectorXd& rest);
   /// Whether the last Newton solve stopped on the cancel token or the deadline.
   bool stopped() const;
@@ -163,8 +163,8 @@ class DesignDriver {
   double m_best_pressure = 0.0;
   bool m_final_equilibrium = true;
 
-  /// Inflates the iterates recorded before the pending check from rest, latest first, until one reaches
-  /// its own design's shape (take_pending_shape_from_rest), within the budget.
+  /// Inflates the iterates recorded before the pending check from rest, earliest first, until one reaches
+  /// another shape than its design's (take_pending_shape_from_rest), within the budget.
   void check_iterates_before_the_pending_one();
 
   /// The check from rest running meanwhile: its rest shape, its iteration, and the design's equilibrium
