@@ -108,14 +108,6 @@ void add_rest_inflation_check(const TriMesh& target, const DesignOptions& option
   hand_back_closest_from_rest(target, target_surface, inflation, result);
 }
 
-}  // namespace
-
-double design_start_scale(const DesignOptions& options) {
-  return options.scale > 0 ? options.scale : std::cbrt(1.0 / options.volume_ratio);
-}
-
-namespace {
-
 /// The design in the target's centred frame (mesh/centred_frame.hpp): refuse what cannot be designed,
 /// then set up the run and hand it to the chosen optimizer.
 DesignResult design_centred(const TriMesh& target, const DesignOptions& options) {
@@ -146,6 +138,10 @@ ProgressCallback in_caller_frame(const CentredFrame& frame, ProgressCallback pro
 }
 
 }  // namespace
+
+double design_start_scale(const DesignOptions& options) {
+  return options.scale > 0 ? options.scale : std::cbrt(1.0 / options.volume_ratio);
+}
 
 /// The entry point (reduced_space_design.hpp, augmented_lagrangian_design.hpp): designed about the
 /// target's bounding-box centre, every position handed back where the caller's target stands.

@@ -385,9 +385,10 @@ void DesignDriver::record(DesignResult& result, int iteration, const SurfaceDist
   sample.max_error_mm = stats.max_mm;
   sample.residual_norm = m_last_report.residual_norm;
   result.log.push_back(sample);
-  if (iteration > 0) {
+  // Kept for the checks from rest, which start every few iterations (DesignOptions::surface_growth_iterations)
+  // in the adjoint method only.
+  if (iteration > 0 && m_options.method == DesignMethod::Adjoint) {
     m_since_check.push_back(Iterate{iteration, rest, m_x, stats.avg_mm});
-    // A check starts every few iterations (DesignOptions::surface_growth_iterations); the ALM never starts one.
     while (static_cast<int>(m_since_check.size()) > std::max(1, m_options.surface_growth_iterations))
       m_since_check.pop_front();
   }
