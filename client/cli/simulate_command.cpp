@@ -50,7 +50,9 @@ constexpr const char* HELP =
     "                      pressure maxima)\n"
     "  --pressure-range A:B\n"
     "                      the same over pressures A..B kPa (0 < A < B <= 1e6), spaced geometrically; under\n"
-    "                      pressure control the path ends at the first pressure above a pressure maximum\n"
+    "                      pressure control a pressure past a maximum gives the larger shape the balloon\n"
+    "                      snaps to (the maximum is listed), or, where the pressure does not climb back\n"
+    "                      by volume ratio 250, ends the path\n"
     "  --points N          number of curve points, 2..1000\n"
     "  --out FILE          write the inflated mesh (.obj, .stl or .ply), only if the run converged\n"
     "                      A curve writes curve.csv and curve.svg into FILE's folder (into FILE if it is a\n"
@@ -181,10 +183,21 @@ std::string summary_from_curve(const v1::CurveReport& report) {
         << format("%12.5g", point.mean_stretch()) << "  " << format("%11.5g", point.max_stretch()) << "  "
         << (point.has_unstable_modes() ? format("%8.0f", point.unstable_modes()) : std::string("       ?")) << "\n";
   }
-  for (const v1::CurveExtremumReport& extremum : report.extrema())
+  const bool pressure_control = report.control() == "pressure";
+  for (const v1::CurveExtremumReport& extremum : report.extrema()) {
     out << "  pressure " << extremum.kind() << " " << format("%.4g", extremum.pressure_kpa()) << " kPa at V/V0 "
         << format("%.4g", extremum.volume_ratio()) << " (stretch " << format("%.4g", std::cbrt(extremum.volume_ratio()))
-        << ")\n";
+        << ")";
+    // Under pressure control the path passes extrema between points; after a maximum the balloon snaps.
+    if (pressure_control && extremum.point() >= 0 && extremum.point() < report.points_size()) {
+      const v1::CurvePointReport& after = report.points(extremum.point());
+      out << ", passed on the way to " << format("%.4g", after.target()) << " kPa";
+      if (extremum.kind() == "maximum" && after.converged())
+        out << ": past it the balloon snaps to a larger shape (V/V0 " << format("%.4g", after.volume_ratio())
+            << " at " << format("%.4g", after.pressure_kpa()) << " kPa)";
+    }
+    out << "\n";
+  }
   return out.str();
 }
 

@@ -72,6 +72,15 @@ enum class InflationStop {
 /// One word per stop reason ("converged", "above_max_pressure", ...), for reports.
 const char* inflation_stop_word(InflationStop stop);
 
+/// A pressure maximum or minimum that a pressure-controlled path passed on its way to the target: the
+/// vertex of the parabola through the volume path's three states around the turn, in log(V / V_rest).
+/// Held at a pressure just above a maximum, a balloon snaps to the larger shape at that pressure.
+struct PassedExtremum {
+  bool maximum = true;        ///< else a minimum
+  double volume_ratio = 0.0;  ///< V / V_rest
+  double pressure_kpa = 0.0;
+};
+
 struct InflationResult {
   bool converged = false;
   InflationStop stop = InflationStop::NoEquilibrium;
@@ -91,6 +100,9 @@ struct InflationResult {
   /// whose edge the simulation flipped: the vertices are the caller's, only those pairs' diagonals differ
   /// (the surface moves by at most a cap's height).
   int flipped_cap_slivers = 0;
+  /// Pressure control: the maxima and minima of the pressure along the volume path from the last
+  /// equilibrium to this one, in path order (none under volume control, which reports every state it asks for).
+  std::vector<PassedExtremum> passed_extrema;
   int newton_iterations = 0;
   int factorizations = 0;
   int load_steps = 0;

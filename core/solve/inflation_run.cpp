@@ -263,6 +263,7 @@ bool InflationRun::stopped(const NewtonReport& report) {
 }
 
 bool InflationRun::inflate_to_volume(PathPoint& state, double target_volume, std::string& message) {
+  m_passed_extrema.clear();  // volume control asks for every state it reports
   double step = target_volume - state.volume;
   const double smallest = 1e-4 * std::abs(target_volume - state.volume) + 1e-12 * target_volume;
   NewtonReport report;
@@ -438,6 +439,7 @@ void InflationRun::fill(InflationResult& result, const PathPoint& state) {
   result.residual_norm = r.norm();
   result.unstable_modes = m_unstable_modes;
   result.wrinkled_elements = m_model.tension_field() ? m_model.relaxed_triangle_count(state.x) : 0;
+  result.passed_extrema = m_passed_extrema;
   result.newton_iterations = m_newton_iterations;
   result.factorizations = m_solver.factorizations();
   result.bending = m_model.bending();

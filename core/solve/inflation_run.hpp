@@ -185,6 +185,10 @@ class InflationRun {
   /// that pressure. A target above the balloon's pressure maximum has no equilibrium and says so.
   bool inflate_to_pressure(PathPoint& state, double target_pressure, std::string& message);
 
+  /// Notes the turn of the pressure at `previous`, the middle of three successive volume-path states
+  /// (m_passed_extrema), where the pressure rose into it and falls after it, or the other way round.
+  void note_pressure_turn(const PathPoint& before, const PathPoint& previous, const PathPoint& after);
+
   /// "the pressure fell after a maximum of P at volume ratio R", for messages about a passed `peak`.
   std::string fall_after(const PathPoint& peak) const;
 
@@ -237,6 +241,7 @@ class InflationRun {
     double from_volume = -1.0, to_volume = -1.0;  ///< mm^3; negative until tried
     PathPoint unfinished;
   } m_bent_try;
+  std::vector<PassedExtremum> m_passed_extrema;  ///< pressure control: since the last equilibrium asked for
   std::string m_final_message = "converged";  ///< the last equilibrium solve's (it may name a rounding floor)
   PathPoint m_unfinished;                   ///< where the last failed attempt ended
   double m_unfinished_start_residual = 0.0;  ///< N, the residual that attempt started from

@@ -9,6 +9,7 @@
 #include <string>
 #include <utility>
 
+#include "solve/parabola_vertex.hpp"
 #include "solve/pressure_bracket.hpp"
 #include "solve/quantity_text.hpp"
 
@@ -45,6 +46,8 @@ bool InflationRun::inflate_to_pressure(PathPoint& state, double target_pressure,
   PathPoint peak = state;
   std::optional<PathPoint> snapped_from;
   NewtonReport report;
+  m_passed_extrema.clear();
+  std::optional<PathPoint> before_previous;  // the path's state before `previous`, once there is one
   while (state.pressure < target_pressure) {
     PathPoint previous = state;
     if (!volume_step(state, state.volume + step, report)) {
@@ -67,6 +70,8 @@ bool InflationRun::inflate_to_pressure(PathPoint& state, double target_pressure,
       }
       continue;
     }
+    if (before_previous) note_pressure_turn(*before_previous, previous, state);
+    before_previous = previous;
     if (state.pressure > peak.pressure) peak = state;
     if (state.pressure < previous.pressure) snapped_from = peak;
     if (state.pressure < target_pressure && snapped_from && state.volume > MAX_VOLUME_RATIO_PAST_A_PEAK * rest_volume)
@@ -85,6 +90,20 @@ bool InflationRun::inflate_to_pressure(PathPoint& state, double target_pressure,
     if (report.iterations <= 6) step *= 2.0;
   }
   return true;
+}
+
+void InflationRun::note_pressure_turn(const PathPoint& before, const PathPoint& previous, const PathPoint& after) {
+  const bool maximum = previous.pressure > before.pressure && previous.pressure > after.pressure;
+  const bool minimum = previous.pressure < before.pressure && previous.pressure < after.pressure;
+  if (!maximum && !minimum) return;
+  const double log_ratio[3] = {std::log(before.volume / m_rest_volume), std::log(previous.volume / m_rest_volume),
+                               std::log(after.volume / m_rest_volume)};
+  const double pressure_kpa[3] = {before.pressure / MPA_PER_KPA, previous.pressure / MPA_PER_KPA,
+                                  after.pressure / MPA_PER_KPA};
+  double vertex_log_ratio = log_ratio[1], vertex_pressure_kpa = pressure_kpa[1];
+  if (log_ratio[0] < log_ratio[1] && log_ratio[1] < log_ratio[2])
+    parabola_vertex(log_ratio, pressure_kpa, &vertex_log_ratio, &vertex_pressure_kpa);
+  m_passed_extrema.push_back({maximum, std::exp(vertex_log_ratio), vertex_pressure_kpa});
 }
 
 std::string InflationRun::fall_after(const PathPoint& peak) const {

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "solve/parabola_vertex.hpp"
 #include "solve/quantity_text.hpp"
 
 namespace balloon {
@@ -19,25 +20,6 @@ double now_s() {
 std::string describe_target(InflationControl control, double target) {
   return control == InflationControl::Pressure ? format_number(target, CURVE_DIGITS) + " kPa"
                                                : "volume ratio " + format_number(target, CURVE_DIGITS);
-}
-
-/// Vertex of the parabola through three points (abscissae distinct): where a sampled extremum lies.
-void parabola_vertex(const double x[3], const double y[3], double* vertex_x, double* vertex_y) {
-  const double a = (x[1] - x[0]) * (y[1] - y[2]), b = (x[1] - x[2]) * (y[1] - y[0]);
-  const double denominator = a - b;
-  double xv = x[1];
-  if (denominator != 0.0) xv = x[1] - 0.5 * ((x[1] - x[0]) * a - (x[1] - x[2]) * b) / denominator;
-  xv = std::clamp(xv, x[0], x[2]);
-  // Lagrange form of the same parabola at xv.
-  double yv = 0.0;
-  for (int i = 0; i < 3; ++i) {
-    double weight = 1.0;
-    for (int j = 0; j < 3; ++j)
-      if (j != i) weight *= (xv - x[j]) / (x[i] - x[j]);
-    yv += weight * y[i];
-  }
-  *vertex_x = xv;
-  *vertex_y = yv;
 }
 
 }  // namespace
@@ -119,6 +101,7 @@ PressureVolumeCurve trace_pressure_volume_curve(const TriMesh& rest, const Press
   InflationPath path(rest, inflation);
 
   std::string stopped;  // set once the path has ended: why the remaining points were not reached
+  std::vector<CurveExtremum> passed;  // pressure control: extrema the path passed between points
   for (size_t i = 0; i < curve.points.size(); ++i) {
     CurvePoint& point = curve.points[i];
     if (!stopped.empty()) {
@@ -126,6 +109,8 @@ PressureVolumeCurve trace_pressure_volume_curve(const TriMesh& rest, const Press
       continue;
     }
     const InflationResult result = path.advance(options.control, point.target);
+    for (const PassedExtremum& turn : result.passed_extrema)
+      passed.push_back({turn.maximum, static_cast<int>(i), turn.volume_ratio, turn.pressure_kpa});
     curve.rest_volume_mm3 = result.rest_volume_mm3;
     curve.newton_iterations = result.newton_iterations;
     curve.factorizations = result.factorizations;
@@ -170,6 +155,7 @@ PressureVolumeCurve trace_pressure_volume_curve(const TriMesh& rest, const Press
     curve.message = "converged";
   }
   curve.extrema = pressure_extrema(curve.points);
+  curve.extrema.insert(curve.extrema.end(), passed.begin(), passed.end());
   curve.time_s = now_s() - start;
   return curve;
 }

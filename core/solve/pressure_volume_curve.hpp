@@ -50,12 +50,16 @@ struct CurvePoint {
 };
 
 /// A local extremum of the pressure along the path: at a converged point whose converged neighbours
-/// both have lower (maximum) or higher (minimum) pressure.
+/// both have lower (maximum) or higher (minimum) pressure, or, under pressure control, one the volume
+/// path passed between two points (InflationResult::passed_extrema).
 struct CurveExtremum {
   bool maximum = true;       ///< a pressure maximum (the balloon snaps past it under pressure); else a minimum
-  int point = 0;             ///< index of the sampled extreme point
+  /// Index of the sampled extreme point; for an extremum that pressure control passed between two points
+  /// (the path's pressures at the points only rise), the index of the point after it.
+  int point = 0;
   /// The extremum estimated by the parabola through that point and its two neighbours, in log(V / V_rest)
-  /// (exact for a quadratic pressure; within a fraction of the point spacing otherwise).
+  /// (exact for a quadratic pressure; within a fraction of the point spacing otherwise); for a passed one,
+  /// through the volume path's states around it.
   double volume_ratio = 0.0;
   double pressure_kpa = 0.0;
 };

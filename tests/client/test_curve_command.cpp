@@ -146,6 +146,23 @@ TEST_F(CurveCommand, PressurePastTheMaximumLeavesEmptyRows) {
   EXPECT_TRUE(std::filesystem::exists(folder / "curve.svg"));
 }
 
+// A stiffening rubber under pressure control: past its maximum the balloon snaps to a larger shape, and
+// the summary and the plot name the maximum and the minimum the path passed between two points. (The
+// sphere of radius 10 mm with issue 14's Hart-Smith rubber peaks near 20 kPa, at V/V0 2.6.)
+TEST_F(CurveCommand, PressurePastAStiffeningRubbersMaximumNamesTheSnap) {
+  const std::filesystem::path folder = s_scratch->path() / "snap";
+  std::filesystem::create_directories(folder);
+  const ProcessResult result = run({"simulate", sphere(), "--material", "hart-smith:G=0.12,k1=5e-4,k2=0.8",
+                                    "--pressure-range", "10:26", "--points", "4", "--out", folder.string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err << result.out;
+  EXPECT_NE(result.out.find("pressure maximum"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("pressure minimum"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("the balloon snaps to a larger shape"), std::string::npos) << result.out;
+  const std::string svg = read_text(folder / "curve.svg");
+  EXPECT_EQ(count(svg, "class=\"pressure-maximum\""), 1u);
+  EXPECT_EQ(count(svg, "class=\"pressure-minimum\""), 1u);
+}
+
 TEST_F(CurveCommand, BadRangesAreOneLineErrors) {
   const std::string missing_folder = (s_scratch->path() / "no" / "such" / "x.obj").string();
   struct Case {

@@ -133,6 +133,47 @@ TEST(PressureVolumeCurve, PressureControlStopsAtThePressureMaximum) {
   EXPECT_NE(curve.message.find("maximum pressure"), std::string::npos) << curve.message;
 }
 
+// A stiffening rubber's pressure climbs again after its maximum (Hart-Smith, issue 14's parameters), so
+// under pressure control a pressure above the maximum is the larger shape the balloon snaps to. The
+// maximum and the minimum that the path passed between two points are named, at the closed form's.
+TEST(PressureVolumeCurve, PressureControlNamesTheMaximumItSnapsPast) {
+  const TriMesh sphere = make_icosphere(10.0, 2);  // 162 vertices
+  const Material rubber = make(MaterialModel::HartSmith, 0.12, 5e-4, 0.8);
+  const double radius = effective_radius(sphere);
+  double max_kpa = 0.0, max_stretch = 1.0, min_kpa = 0.0, min_stretch = 1.0;
+  for (double stretch = 1.0; stretch < 8.0; stretch += 1e-4) {
+    const double p = 1e3 * sphere_pressure(rubber, radius, 0.5, stretch);
+    if (min_kpa == 0.0 && p > max_kpa) max_kpa = p, max_stretch = stretch;
+    if (p < max_kpa && (min_kpa == 0.0 || p < min_kpa)) min_kpa = p, min_stretch = stretch;
+  }
+  ASSERT_GT(max_stretch, 1.1);
+  ASSERT_GT(min_stretch, max_stretch);
+  // 0.5, 0.6, 0.73, 0.88, 1.07 and 1.3 times the maximum: the last two past it.
+  PressureVolumeCurveOptions options = volume_curve(rubber, 0.5 * max_kpa, 1.3 * max_kpa, 6);
+  options.control = InflationControl::Pressure;
+  const PressureVolumeCurve curve = trace_pressure_volume_curve(sphere, options);
+  ASSERT_TRUE(curve.converged) << curve.message;
+  for (const CurvePoint& point : curve.points) {
+    const double expected = 1e3 * sphere_pressure(rubber, radius, 0.5, std::cbrt(*point.volume_ratio));
+    EXPECT_NEAR(*point.pressure_kpa, expected, 5e-3 * expected) << "at " << point.target << " kPa";
+  }
+  EXPECT_LT(*curve.points[3].volume_ratio, std::pow(max_stretch, 3));
+  EXPECT_GT(*curve.points[4].volume_ratio, std::pow(min_stretch, 3));  // on the far branch
+  ASSERT_EQ(curve.extrema.size(), 2u);
+  const CurveExtremum& peak = curve.extrema[0];
+  const CurveExtremum& valley = curve.extrema[1];
+  EXPECT_TRUE(peak.maximum);
+  EXPECT_FALSE(valley.maximum);
+  EXPECT_EQ(peak.point, 4);
+  EXPECT_EQ(valley.point, 4);
+  // Measured: 0.7% and 0.8% from the closed form in pressure, 0.9% and 1.4% in stretch (162 vertices, the
+  // parabola through the volume path's steps).
+  EXPECT_NEAR(peak.pressure_kpa, max_kpa, 1.5e-2 * max_kpa);
+  EXPECT_NEAR(valley.pressure_kpa, min_kpa, 1.5e-2 * min_kpa);
+  EXPECT_NEAR(std::cbrt(peak.volume_ratio), max_stretch, 3e-2 * max_stretch);
+  EXPECT_NEAR(std::cbrt(valley.volume_ratio), min_stretch, 3e-2 * min_stretch);
+}
+
 TEST(PressureVolumeCurve, BadRangesAreReportedNotThrown) {
   const TriMesh sphere = make_icosphere(10.0, 1);
   const Material nh = make(MaterialModel::NeoHookean, 0.3);
