@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "solve/inflation_run.hpp"
 #include "solve/parabola_vertex.hpp"
 #include "solve/quantity_text.hpp"
 
@@ -121,6 +122,19 @@ PressureVolumeCurve trace_pressure_volume_curve(const TriMesh& rest, const Press
       point.message = result.message;
       curve.stop = result.stop;
       curve.message = "the path stopped at " + describe_target(options.control, point.target) + ": " + result.message;
+      stopped = "the path stopped at " + describe_target(options.control, point.target);
+      continue;
+    }
+    // As a single inflation ends where its walls pass through each other (inflate()), so does the curve:
+    // past that, this model (no contact) follows no balloon. (A silicone knot's curve went on from x2.2,
+    // where they touch, through seven such points to x3.3, where Newton crept for 60 s and failed.)
+    if (passes_through_itself(rest, result.deformed)) {
+      point.message = "no equilibrium: the " + std::string(result.bending ? "bent sheet's" : "membrane's") +
+                      " equilibrium at volume ratio " + format_number(result.volume_ratio, CURVE_DIGITS) + " (" +
+                      format_number(result.pressure_kpa, CURVE_DIGITS) +
+                      " kPa) passes through itself; its walls touch there, and this model has no contact";
+      curve.stop = InflationStop::PassesThroughItself;
+      curve.message = "the path stopped at " + describe_target(options.control, point.target) + ": " + point.message;
       stopped = "the path stopped at " + describe_target(options.control, point.target);
       continue;
     }

@@ -9,6 +9,7 @@
 #include "mesh/icosphere.hpp"
 #include "mesh/mesh_geometry.hpp"
 #include "mesh/mesh_io.hpp"
+#include "mesh/self_intersection.hpp"
 #include "core/mesh/mesh_test_helpers.hpp"
 #include "solve/pressure_volume_curve.hpp"
 
@@ -216,6 +217,29 @@ TEST(PressureVolumeCurve, SaysWhatTheModelAddedBeyondTheMembrane) {
   ASSERT_TRUE(bent.converged) << bent.message;
   EXPECT_TRUE(bent.bending);
   EXPECT_EQ(bent.flipped_cap_slivers, 0);
+}
+
+// The curve ends where its walls pass through each other, as a single inflation does (inflate()): past
+// that this model, with no contact, follows no balloon. The knot at 20 mm with Neo-Hookean rubber, whose
+// strands touch on the way to x8 (Inflation.TheSqpShiftOnlyRemovesWhatTheVolumeConstraintLeavesUnstable).
+TEST(PressureVolumeCurve, EndsWhereItsWallsPassThroughEachOther) {
+  auto knot = read_mesh(std::string(BALLOON_TEST_DATA_DIR) + "/meshes/knot.off");
+  ASSERT_TRUE(knot.ok()) << knot.error();
+  knot->vertices *= 20.0 / bounding_box_diagonal(knot->vertices);
+  const PressureVolumeCurve curve =
+      trace_pressure_volume_curve(*knot, volume_curve(make(MaterialModel::NeoHookean, 0.3), 1.5, 8.0, 5));
+  EXPECT_FALSE(curve.converged);
+  EXPECT_EQ(curve.stop, InflationStop::PassesThroughItself) << curve.message;
+  ASSERT_GE(curve.last_converged_point, 0) << curve.message;
+  ASSERT_LT(curve.last_converged_point, 4);
+  const CurvePoint& touching = curve.points[static_cast<size_t>(curve.last_converged_point) + 1];
+  EXPECT_FALSE(touching.converged);
+  EXPECT_FALSE(touching.volume_ratio || touching.pressure_kpa);
+  EXPECT_NE(touching.message.find("passes through itself"), std::string::npos) << touching.message;
+  EXPECT_NE(curve.message.find("passes through itself"), std::string::npos) << curve.message;
+  TriMesh last = *knot;
+  last.vertices = curve.last_shape;
+  EXPECT_FALSE(mesh_self_intersects(last));
 }
 
 }  // namespace
