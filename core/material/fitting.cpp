@@ -354,6 +354,7 @@ Result<FitResult> fit_material(MaterialModel model, const std::vector<Measuremen
     fit.label = set.label;
     fit.kind = set.kind;
     fit.points = static_cast<int>(set.x.size());
+    fit.dropped_compression_points = set.dropped_compression_points;
     fit.residual_unit = set.kind == TestKind::Bulge ? "kPa" : "MPa";
     (set.kind == TestKind::Bulge ? has_bulge : has_stress) = true;
     const auto y = problem.model_y(best, s);

@@ -83,6 +83,7 @@ struct SetFit {
   std::string label;
   TestKind kind = TestKind::Uniaxial;
   int points = 0;
+  int dropped_compression_points = 0;  ///< stress tables: rows with stretch < 1 the parser left out (MeasurementSet)
   double rms_residual = 0, max_residual = 0;  ///< |y_model - y_data| in residual_unit
   std::string residual_unit;                  ///< "MPa" (nominal stress) or "kPa" (bulge pressure)
   double rms_relative_residual = 0, max_relative_residual = 0;  ///< the fitted relative residuals

@@ -191,6 +191,7 @@ void write_fit_members(JsonWriter& json, const FitResult& fit) {
     json.value("label", set.label);
     json.value("test", test_kind_name(set.kind));
     json.value("points", set.points);
+    json.value("dropped_compression_points", set.dropped_compression_points);
     json.value("rms_residual", set.rms_residual);
     json.value("max_residual", set.max_residual);
     json.value("residual_unit", set.residual_unit);
@@ -250,8 +251,13 @@ std::string fit_summary_text(const FitInput& input, const FitOutcome& outcome) {
         << ", max " << fit.max_residual << " " << fit.residual_unit << " (relative rms "
         << 100 * fit.rms_relative_residual << "%)\n";
     for (const SetFit& set : fit.sets)
-      out << "  " << set.label << " (" << test_kind_name(set.kind) << ", " << set.points << " points): rms "
-          << set.rms_residual << " " << set.residual_unit << ", max " << set.max_residual << " " << set.residual_unit
+      out << "  " << set.label << " (" << test_kind_name(set.kind) << ", " << set.points << " points"
+          << (set.dropped_compression_points > 0
+                  ? "; " + std::to_string(set.dropped_compression_points) +
+                        (set.dropped_compression_points == 1 ? " row" : " rows") +
+                        " with stretch below 1 left out: compression is not fitted"
+                  : std::string())
+          << "): rms " << set.rms_residual << " " << set.residual_unit << ", max " << set.max_residual << " " << set.residual_unit
           << "\n";
     out << "  regimes: data " << regimes_text(fit.data_inflection, fit.data_stiffening) << ", model "
         << regimes_text(fit.model_inflection, fit.model_stiffening) << "\n";

@@ -235,6 +235,7 @@ v1::FitReport fit_report(const jobs::FitInput& input, const jobs::FitOutcome& ou
       set_out->set_label(set.label);
       set_out->set_test(test_kind_name(set.kind));
       set_out->set_points(set.points);
+      set_out->set_dropped_compression_points(set.dropped_compression_points);
       set_out->set_rms_residual(set.rms_residual);
       set_out->set_max_residual(set.max_residual);
       set_out->set_residual_unit(set.residual_unit);
@@ -305,6 +306,7 @@ Result<jobs::FitOutcome> fit_outcome_from_report(const jobs::FitInput& input, co
       set.label = input.sets[s].label;
       set.kind = input.sets[s].kind;
       set.points = set_in.points();
+      set.dropped_compression_points = set_in.dropped_compression_points();
       set.rms_residual = set_in.rms_residual();
       set.max_residual = set_in.max_residual();
       set.residual_unit = set_in.residual_unit();

@@ -160,6 +160,21 @@ TEST_F(FitMaterialCommand, BadDataIsRejectedWithOneLineAndNothingStored) {
     EXPECT_EQ(listed.out.find(std::string("\n") + name + " "), std::string::npos) << name << " was stored:\n" << listed.out;
 }
 
+// Rows in compression (stretch < 1) are not fitted; the summary and the JSON say how many were left out
+// instead of fitting fewer points than the file has without a word.
+TEST_F(FitMaterialCommand, RowsInCompressionLeftOutAreCounted) {
+  const std::string data = write("compression.csv",
+                                 "stretch,nominal_stress_MPa\n0.5,-1.0\n0.8,-0.3\n1.2,0.2\n1.5,0.35\n2.0,0.5\n");
+  const ProcessResult summary = run({"fit-material", data, "--test", "uniaxial", "--model", "neo-hookean"});
+  ASSERT_EQ(summary.exit_code, 0) << summary.err;
+  EXPECT_NE(summary.out.find("3 points; 2 rows with stretch below 1 left out: compression is not fitted"),
+            std::string::npos)
+      << summary.out;
+  const ProcessResult json = run({"fit-material", data, "--test", "uniaxial", "--model", "neo-hookean", "--json"});
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  EXPECT_NE(json.out.find("\"dropped_compression_points\":2"), std::string::npos) << json.out;
+}
+
 TEST_F(FitMaterialCommand, EachFileTakesTheTestBeforeIt) {
   const std::string data = std::string(BALLOON_TEST_DATA_DIR) + "/materials/";
   const ProcessResult result = run({"fit-material", "--test", "uniaxial", data + "treloar1944_ut.csv", "--test",
