@@ -189,7 +189,8 @@ class InflationRun {
   /// (m_passed_extrema), where the pressure rose into it and falls after it, or the other way round.
   void note_pressure_turn(const PathPoint& before, const PathPoint& previous, const PathPoint& after);
 
-  /// "the pressure fell after a maximum of P at volume ratio R", for messages about a passed `peak`.
+  /// "the pressure fell after a maximum of P at volume ratio R", for messages about a passed `peak` (the
+  /// path's highest state; where m_passed_extrema holds a maximum at least as high, that one's estimate).
   std::string fall_after(const PathPoint& peak) const;
 
   /// Pressure control asked for more than the path's highest pressure: the state goes back to that peak.

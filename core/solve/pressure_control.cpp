@@ -107,8 +107,14 @@ void InflationRun::note_pressure_turn(const PathPoint& before, const PathPoint& 
 }
 
 std::string InflationRun::fall_after(const PathPoint& peak) const {
-  return "the pressure fell after a maximum of " + format_kpa(peak.pressure) + " at volume ratio " +
-         format_number(peak.volume / m_rest_volume);
+  // The highest maximum the path noted is that peak, placed between the path's steps as the curve's
+  // extrema are, so that a report names one maximum, not two.
+  double pressure_mpa = peak.pressure, volume_ratio = peak.volume / m_rest_volume;
+  for (const PassedExtremum& turn : m_passed_extrema)
+    if (turn.maximum && turn.pressure_kpa * MPA_PER_KPA >= pressure_mpa)
+      pressure_mpa = turn.pressure_kpa * MPA_PER_KPA, volume_ratio = turn.volume_ratio;
+  return "the pressure fell after a maximum of " + format_kpa(pressure_mpa) + " at volume ratio " +
+         format_number(volume_ratio);
 }
 
 bool InflationRun::above_maximum_pressure(PathPoint& state, const PathPoint& peak, double target_pressure, std::string& message) {
