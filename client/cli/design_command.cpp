@@ -165,6 +165,32 @@ std::string shown_number(bool has, double value, const char* pattern, double sca
   return has ? format(pattern, scale * value) : "n/a";
 }
 
+/// Above this share of the inflated surface in the rubber's band of falling pressure, the summary
+/// says what that does to a balloon and which volume ratios avoid it.
+constexpr double PRESSURE_FALL_ADVICE_SHARE = 0.5;
+
+/// The rubber's band of falling pressure and the share of the inflated design in it, as one line.
+std::string pressure_fall_line(const v1::PressureFallBand& band) {
+  std::string line = "  rubber         its pressure falls as it stretches ";
+  if (band.has_to_stretch())
+    line += "between stretch " + format("%.4g", band.from_stretch()) + " and " + format("%.4g", band.to_stretch()) +
+            " (volume ratio " + format("%.3g", band.from_volume_ratio()) + " to " +
+            format("%.3g", band.to_volume_ratio()) + ")";
+  else
+    line += "past stretch " + format("%.4g", band.from_stretch()) + " (volume ratio " +
+            format("%.3g", band.from_volume_ratio()) + ")";
+  if (!band.has_area_share()) return line + "\n";
+  line += format("; %.0f%% of the inflated surface is stretched there", 100.0 * band.area_share());
+  if (band.area_share() > PRESSURE_FALL_ADVICE_SHARE) {
+    line += ": long or thin parts of a balloon there bulge one at a time instead of inflating evenly (as a long "
+            "party balloon does), so the design may not reach the target whatever its rest shape; a volume ratio "
+            "below " + format("%.3g", band.from_volume_ratio());
+    if (band.has_to_volume_ratio()) line += " or above " + format("%.3g", band.to_volume_ratio());
+    line += " keeps the sheet out of it";
+  }
+  return line + "\n";
+}
+
 std::string summary_from_report(const v1::DesignReport& report, const std::string& out_dir) {
   std::ostringstream out;
   out << (report.converged() ? "converged" : "NOT converged")
@@ -198,6 +224,7 @@ std::string summary_from_report(const v1::DesignReport& report, const std::strin
     if (check.converged() && check.unstable_modes() > 0)
       out << "  stability      from rest, " << saddle_note(check.unstable_modes()) << "\n";
   }
+  if (report.has_pressure_fall()) out << pressure_fall_line(report.pressure_fall());
   if (report.has_tolerance() && report.tolerance().levels_size() > 0) {
     out << "  tolerance     ";
     for (const v1::ToleranceLevel& level : report.tolerance().levels())

@@ -8,6 +8,7 @@
 #include "design/closest_from_rest.hpp"
 #include "design/design_driver.hpp"
 #include "design/multiresolution_design.hpp"
+#include "design/pressure_fall_share.hpp"
 #include "design/reduced_space_design.hpp"
 #include "design/rest_inflation_check.hpp"
 #include "material/thin_sheet.hpp"
@@ -108,6 +109,15 @@ void add_rest_inflation_check(const TriMesh& target, const DesignOptions& option
   hand_back_closest_from_rest(target, target_surface, inflation, result);
 }
 
+/// The rubber's band of falling pressure, and how much of the handed-back inflated shape lies in it.
+void add_pressure_fall(const DesignOptions& options, DesignResult& result) {
+  result.pressure_fall = pressure_fall_band(options.material);
+  const bool have_design = result.avg_error_mm && result.rest.vertex_count() > 0 &&
+                           result.inflated.rows() == result.rest.vertex_count();
+  if (result.pressure_fall && have_design)
+    result.pressure_fall_area_share = area_share_in_pressure_fall(result.rest, result.inflated, *result.pressure_fall);
+}
+
 /// The design in the target's centred frame (mesh/centred_frame.hpp): refuse what cannot be designed,
 /// then set up the run and hand it to the chosen optimizer.
 DesignResult design_centred(const TriMesh& target, const DesignOptions& options) {
@@ -122,6 +132,7 @@ DesignResult design_centred(const TriMesh& target, const DesignOptions& options)
   }
   DesignResult result = run_optimizer(target, options);
   if (options.check_from_rest) add_rest_inflation_check(target, options, result);
+  add_pressure_fall(options, result);
   return result;
 }
 

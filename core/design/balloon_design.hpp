@@ -7,6 +7,7 @@
 
 #include "design/rest_inflation_check.hpp"
 #include "material/material.hpp"
+#include "material/pressure_fall_band.hpp"
 #include "mesh/tri_mesh.hpp"
 #include "progress.hpp"
 
@@ -165,6 +166,12 @@ struct DesignResult {
   /// the target; none without an inflated start. Where the final design inflates from rest farther
   /// from the target, or finds no equilibrium there, this one is handed back (closest_from_rest.hpp).
   std::optional<CheckedFromRest> closest_from_rest;
+  /// Where the rubber's sphere pressure falls as it stretches (material/pressure_fall_band.hpp); none
+  /// when it never does.
+  std::optional<PressureFallBand> pressure_fall;
+  /// The share (0..1) of the handed-back inflated shape's area stretched into that band
+  /// (pressure_fall_share.hpp); none without a design or without a band.
+  std::optional<double> pressure_fall_area_share;
 };
 
 /// Designs the rest shape for `target`. Never throws for bad numerics: failures are in the result.

@@ -1,6 +1,7 @@
 #include "service/job_reports.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace balloon::service {
@@ -195,6 +196,17 @@ v1::DesignReport design_report(const jobs::DesignInput& input, const jobs::Desig
     if (check->deviation_mm) out->set_deviation_mm(*check->deviation_mm);
     out->set_another_shape(check->another_shape);
     out->set_time_s(check->time_s);
+  }
+
+  if (const std::optional<PressureFallBand>& band = result.pressure_fall) {
+    v1::PressureFallBand* out = report.mutable_pressure_fall();
+    out->set_from_stretch(band->from_stretch);
+    out->set_from_volume_ratio(std::pow(band->from_stretch, 3));
+    if (band->to_stretch) {
+      out->set_to_stretch(*band->to_stretch);
+      out->set_to_volume_ratio(std::pow(*band->to_stretch, 3));
+    }
+    if (result.pressure_fall_area_share) out->set_area_share(*result.pressure_fall_area_share);
   }
 
   v1::ConvergenceLog* log = report.mutable_convergence();

@@ -333,6 +333,10 @@ int main(int argc, char** argv) {
         }
         if (const auto reached = time_to_target(r))
           std::printf("%-22s   <= 1%% of the diagonal and >= 3x the baseline after %.1f s\n", "", *reached);
+        if (r.pressure_fall && r.pressure_fall_area_share)
+          std::printf("%-22s   %.0f%% of the inflated surface stretched where the rubber's pressure falls (stretch %.4g to %s)\n",
+                      "", 100.0 * *r.pressure_fall_area_share, r.pressure_fall->from_stretch,
+                      r.pressure_fall->to_stretch ? std::to_string(*r.pressure_fall->to_stretch).c_str() : "beyond");
         if (std::find(r.active_terms.begin(), r.active_terms.end(), "sheet_bending") != r.active_terms.end())
           std::printf("%-22s   the sheet's bending was on (the membrane alone wrinkled with no stable state)\n", "");
         if (r.coarse_stage)

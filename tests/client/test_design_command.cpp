@@ -145,6 +145,38 @@ TEST_F(DesignCommand, SmallDesignWritesTheFiveFilesWithTheContractKeys) {
   EXPECT_GT(mold->face_count(), rest->face_count());  // the tube adds faces
 }
 
+// Latex's sphere pressure falls between stretch 1.365 and 3.966. The regular icosahedron inflates onto
+// itself, every triangle by the sphere's stretch cbrt(ratio), so its design is matched at once: at x8
+// (stretch 2) all of it is in that band and the summary says what that means; at x2 (stretch 1.26) none.
+TEST_F(DesignCommand, TheSummarySaysWhereTheRubbersPressureFallsAndHowMuchOfTheDesignIsThere) {
+  const std::string icosahedron = s_scratch->file("icosahedron.obj");
+  ASSERT_TRUE(write_mesh(make_icosphere(50.0, 0), icosahedron).ok());
+  const ProcessResult past = run({"design", icosahedron, "--material", "latex", "--resolution", "0", "--volume-ratio",
+                                  "8", "--out-dir", s_scratch->file("fall-8")});
+  ASSERT_EQ(past.exit_code, 0) << past.err;
+  // The maximum is at stretch 1.3654, a volume ratio of 2.546.
+  EXPECT_NE(past.out.find("rubber         its pressure falls as it stretches between stretch 1.365 and 3.966 "
+                          "(volume ratio 2.55 to 62.4); 100% of the inflated surface is stretched there: "),
+            std::string::npos)
+      << past.out;
+  EXPECT_NE(past.out.find("bulge one at a time"), std::string::npos) << past.out;
+  EXPECT_NE(past.out.find("a volume ratio below 2.55 or above 62.4 keeps the sheet out of it"), std::string::npos)
+      << past.out;
+  const std::string json = read_text(s_scratch->file("fall-8") + "/report.json");
+  const std::optional<std::string> band = json_field(json, "pressure_fall");
+  ASSERT_TRUE(band) << json;
+  EXPECT_NEAR(json_number_field(*band, "area_share"), 1.0, 1e-12) << *band;
+  EXPECT_NEAR(json_number_field(*band, "from_volume_ratio"), 2.546, 2e-3) << *band;
+
+  const ProcessResult before = run({"design", icosahedron, "--material", "latex", "--resolution", "0",
+                                    "--volume-ratio", "2", "--out-dir", s_scratch->file("fall-2")});
+  ASSERT_EQ(before.exit_code, 0) << before.err;
+  EXPECT_NE(before.out.find("(volume ratio 2.55 to 62.4); 0% of the inflated surface is stretched there\n"),
+            std::string::npos)
+      << before.out;
+  EXPECT_EQ(before.out.find("bulge"), std::string::npos) << before.out;
+}
+
 // A design stopped before its start was ever inflated has no error to report: report.json says null, never
 // 0, and `jobs result` writes the same report.json (and the same files) for that job as `balloon design` did.
 TEST_F(DesignCommand, ADesignWithoutErrorsReportsNullAndJobsResultWritesTheSameFiles) {

@@ -16,6 +16,7 @@ import { ApiClient, ApiError, base64_from_bytes, bytes_from_base64 } from '../..
 import { format_error_mm } from '../../client/web/src/format.js';
 import { CURVE_FIRST_RATIO, CURVE_LAST_RATIO_CAP, CURVE_POINTS, curve_spec_for_design } from '../../client/web/src/curve_request.js';
 import { curve_summary_lines } from '../../client/web/src/curve_summary.js';
+import { pressure_fall_line } from '../../client/web/src/pressure_fall_line.js';
 
 test('SSE parser: events split across chunks, CRLF, comments and multi-line data', () => {
   const parser = new SseParser();
@@ -227,4 +228,18 @@ test('curve summary: converged count, range and each extremum in words; no maxim
   assert.equal(lines.length, 3);
   const rising = curve_summary_lines({ ...report, extrema: [] });
   assert.match(rising[1], /^No pressure maximum up to where the curve stopped/);
+});
+
+test('pressure fall: the band, the share of the design in it, and advice only when most of it is there', () => {
+  const band = { from_stretch: 1.365, to_stretch: 3.966, from_volume_ratio: 2.543, to_volume_ratio: 62.38 };
+  assert.equal(pressure_fall_line(undefined), '');
+  assert.equal(pressure_fall_line(band),
+    "This rubber's pressure falls as it stretches between stretch 1.365 and 3.966 (volume ratio 2.54 to 62.4).");
+  const few = pressure_fall_line({ ...band, area_share: 0.12 });
+  assert.match(few, /; 12 % of the inflated surface is stretched there\.$/);
+  const most = pressure_fall_line({ ...band, area_share: 0.97 });
+  assert.match(most, /97 % of the inflated surface .* bulge one at a time .* below 2\.54 or above 62\.4 keeps the sheet out of it\.$/);
+  const forever = pressure_fall_line({ from_stretch: 1.383, from_volume_ratio: 2.646, area_share: 1 });
+  assert.match(forever, /past stretch 1\.383 \(volume ratio 2\.65\).* below 2\.65 keeps/);
+  assert.doesNotMatch(forever, /above/);
 });

@@ -8,6 +8,7 @@ import { curve_summary_lines } from './curve_summary.js';
 import { show_error } from './field_errors.js';
 import { format_error_mm, format_number, is_active_state, kind_label, state_label } from './format.js';
 import { parse_obj } from './obj_parser.js';
+import { pressure_fall_line } from './pressure_fall_line.js';
 import { SurfaceDistance } from './surface_distance.js';
 
 /**
@@ -459,6 +460,8 @@ export class JobPanel {
         (from_rest.unstable_modes > 0 ? `; there it is a saddle under volume control (${from_rest.unstable_modes} unstable ` +
           'directions: wrinkling or symmetry breaking), and the real balloon may take another shape.' : '.'));
     else if (from_rest && from_rest.message) lines.push(from_rest.message);
+    const pressure_fall = pressure_fall_line(report.pressure_fall);
+    if (pressure_fall) lines.push(pressure_fall);
     if (report.mold_problem) lines.push(`No mold: ${report.mold_problem}`);
     if (job.kind === 'JOB_KIND_CURVE') lines.push(...curve_summary_lines(report));
     summary.replaceChildren(...lines.map((line) => {

@@ -314,6 +314,40 @@ TEST(BalloonDesign, AStartThatAlreadyMatchesIsMatchedNotStalled) {
   EXPECT_EQ(*design.avg_error_mm, *design.baseline_avg_error_mm);
 }
 
+TEST(BalloonDesign, SaysHowMuchOfTheInflatedBalloonIsWhereItsRubbersPressureFalls) {
+  // The regular icosahedron inflates evenly: every triangle by the sphere's stretch cbrt(ratio). Latex's
+  // sphere pressure falls between stretch 1.365 and 3.966, so at x8 (stretch 2) the whole surface is in
+  // that band and at x2 (stretch 1.26) none of it.
+  const TriMesh icosahedron = make_icosphere(50.0, 0);
+  DesignOptions options;
+  options.material = *parse_material_spec("latex");
+  for (const auto& [ratio, share] : {std::pair{8.0, 1.0}, std::pair{2.0, 0.0}}) {
+    options.volume_ratio = ratio;
+    const DesignResult design = design_balloon(icosahedron, options);
+    ASSERT_TRUE(design.avg_error_mm) << design.message;
+    ASSERT_TRUE(design.pressure_fall);
+    EXPECT_NEAR(design.pressure_fall->from_stretch, 1.365, 2e-3);
+    ASSERT_TRUE(design.pressure_fall_area_share) << "x" << ratio;
+    EXPECT_NEAR(*design.pressure_fall_area_share, share, 1e-9) << "x" << ratio;
+  }
+  // A rubber that stiffens before its pressure could peak has no such band.
+  options.material = *parse_material_spec("hart-smith:G=0.15,k1=1,k2=0.8");
+  options.volume_ratio = 8.0;
+  const DesignResult stiff = design_balloon(icosahedron, options);
+  ASSERT_TRUE(stiff.avg_error_mm) << stiff.message;
+  EXPECT_FALSE(stiff.pressure_fall);
+  EXPECT_FALSE(stiff.pressure_fall_area_share);
+  // Without a design the band is known and the share is not (null, never 0).
+  options.material = *parse_material_spec("latex");
+  CancelToken cancel;
+  cancel.cancel();
+  options.cancel = &cancel;
+  const DesignResult none = design_balloon(make_icosphere(20.0, 2), options);
+  ASSERT_FALSE(none.avg_error_mm);
+  EXPECT_TRUE(none.pressure_fall);
+  EXPECT_FALSE(none.pressure_fall_area_share);
+}
+
 TEST(BalloonDesign, AStalledDesignIsNotCalledConverged) {
   // A box with flat faces and sharp edges: no inflated membrane matches it, so the design improves on
   // the start, then stops improving. That is a stall, reported as one, never as convergence. It took
