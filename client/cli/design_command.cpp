@@ -57,7 +57,11 @@ constexpr const char* HELP =
     "  --volume-ratio R       ... from the target scaled to 1/R of its volume (1 < R <= 1000, default 8);\n"
     "                         adjoint holds that rest volume, so its design inflates by R; alm (the\n"
     "                         paper's method, at the start's pressure) lets the rest volume follow, and\n"
-    "                         the report gives the ratio its design inflates by\n"
+    "                         the report gives the ratio its design inflates by. Where the rubber's\n"
+    "                         pressure falls as it stretches (latex: volume ratio 2.55 to 62.4, x8\n"
+    "                         included), long or thin parts can bulge one at a time; the summary's\n"
+    "                         `rubber` line and report.json's pressure_fall say how much of the design\n"
+    "                         is there\n"
     "  --method M             optimizer: adjoint (reduced space) or alm (augmented Lagrangian);\n"
     "                         default: the optimizer's default\n"
     "  --nozzle auto|X,Y,Z[,R]  hold the rest vertices within R mm (default 5% of the bbox diagonal) of\n"
@@ -182,9 +186,9 @@ std::string pressure_fall_line(const v1::PressureFallBand& band) {
   if (!band.has_area_share()) return line + "\n";
   line += format("; %.0f%% of the inflated surface is stretched there", 100.0 * band.area_share());
   if (band.area_share() > PRESSURE_FALL_ADVICE_SHARE) {
-    line += ": long or thin parts of a balloon there bulge one at a time instead of inflating evenly (as a long "
-            "party balloon does), so the design may not reach the target whatever its rest shape; a volume ratio "
-            "below " + format("%.3g", band.from_volume_ratio());
+    line += ": long or thin parts of a balloon there can bulge one at a time instead of inflating evenly (as a "
+            "long party balloon does), and the design may then not reach the target; a volume ratio below " +
+            format("%.3g", band.from_volume_ratio());
     if (band.has_to_volume_ratio()) line += " or above " + format("%.3g", band.to_volume_ratio());
     line += " keeps the sheet out of it";
   }

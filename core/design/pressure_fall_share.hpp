@@ -1,8 +1,8 @@
 #pragma once
 /// How much of an inflated balloon is stretched where its rubber loses pressure as it grows
-/// (material/pressure_fall_band.hpp). A balloon mostly inside that band inflates evenly only where
-/// it is one round chamber: its long or thin parts bulge one at a time instead, so a design there may
-/// not reach its target whatever its rest shape, and a volume ratio outside the band can.
+/// (material/pressure_fall_band.hpp). In that band a balloon's long or thin parts can bulge one at a
+/// time instead of inflating evenly, and a design may then not reach its target; a volume ratio
+/// outside the band keeps the sheet out of it.
 #include "material/pressure_fall_band.hpp"
 #include "mesh/tri_mesh.hpp"
 

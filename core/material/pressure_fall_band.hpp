@@ -3,7 +3,7 @@
 /// (homogeneous_tests.hpp, sphere_pressure) rises to a maximum, and for most rubbers falls past it
 /// until the rubber's stiffening makes it rise again at a minimum. Between the two, a part of a
 /// balloon that stretches further needs less pressure, not more: a long or thin part inflated there
-/// does not grow evenly, one region bulges while the rest stays small, as a long party balloon does.
+/// can stop growing evenly, one region bulging while the rest stays small, as a long party balloon does.
 /// The band depends on the law alone: the sphere's radius and wall thickness only scale its pressure.
 #include <optional>
 

@@ -175,6 +175,8 @@ TEST_F(DesignCommand, TheSummarySaysWhereTheRubbersPressureFallsAndHowMuchOfTheD
             std::string::npos)
       << before.out;
   EXPECT_EQ(before.out.find("bulge"), std::string::npos) << before.out;
+  // The help quotes latex's band: the same numbers as the report's.
+  EXPECT_NE(run({"design", "--help"}).out.find("(latex: volume ratio 2.55 to 62.4, x8"), std::string::npos);
 }
 
 // A design stopped before its start was ever inflated has no error to report: report.json says null, never

@@ -21,8 +21,8 @@ export function pressure_fall_line(band) {
   if (band.area_share == null) return `${line}.`;
   line += `; ${format_number(100 * band.area_share, 3)} % of the inflated surface is stretched there`;
   if (band.area_share <= PRESSURE_FALL_ADVICE_SHARE) return `${line}.`;
-  return `${line}: long or thin parts of a balloon there bulge one at a time instead of inflating evenly (as a long ` +
-    'party balloon does), so the design may not reach the target whatever its rest shape; a volume ratio below ' +
+  return `${line}: long or thin parts of a balloon there can bulge one at a time instead of inflating evenly (as a ` +
+    'long party balloon does), and the design may then not reach the target; a volume ratio below ' +
     `${format_number(band.from_volume_ratio, 3)}${has_end ? ` or above ${format_number(band.to_volume_ratio, 3)}` : ''} ` +
     'keeps the sheet out of it.';
 }
