@@ -23,6 +23,7 @@
 #include "material_argument.hpp"
 #include "mesh/mesh_io.hpp"
 #include "job_command.hpp"
+#include "pressure_fall_line.hpp"
 #include "result_files.hpp"
 #include "service_connection.hpp"
 #include "simulate_request.hpp"
@@ -167,32 +168,6 @@ Result<v1::SubmitJobRequest> design_request_from_args(const ParsedArgs& args) {
 /// A report number formatted with `pattern`, or "n/a" when the report has none (never computed).
 std::string shown_number(bool has, double value, const char* pattern, double scale = 1.0) {
   return has ? format(pattern, scale * value) : "n/a";
-}
-
-/// Above this share of the inflated surface in the rubber's band of falling pressure, the summary
-/// says what that does to a balloon and which volume ratios avoid it.
-constexpr double PRESSURE_FALL_ADVICE_SHARE = 0.5;
-
-/// The rubber's band of falling pressure and the share of the inflated design in it, as one line.
-std::string pressure_fall_line(const v1::PressureFallBand& band) {
-  std::string line = "  rubber         its pressure falls as it stretches ";
-  if (band.has_to_stretch())
-    line += "between stretch " + format("%.4g", band.from_stretch()) + " and " + format("%.4g", band.to_stretch()) +
-            " (volume ratio " + format("%.3g", band.from_volume_ratio()) + " to " +
-            format("%.3g", band.to_volume_ratio()) + ")";
-  else
-    line += "past stretch " + format("%.4g", band.from_stretch()) + " (volume ratio " +
-            format("%.3g", band.from_volume_ratio()) + ")";
-  if (!band.has_area_share()) return line + "\n";
-  line += format("; %.0f%% of the inflated surface is stretched there", 100.0 * band.area_share());
-  if (band.area_share() > PRESSURE_FALL_ADVICE_SHARE) {
-    line += ": long or thin parts of a balloon there can bulge one at a time instead of inflating evenly (as a "
-            "long party balloon does), and the design may then not reach the target; a volume ratio below " +
-            format("%.3g", band.from_volume_ratio());
-    if (band.has_to_volume_ratio()) line += " or above " + format("%.3g", band.to_volume_ratio());
-    line += " keeps the sheet out of it";
-  }
-  return line + "\n";
 }
 
 std::string summary_from_report(const v1::DesignReport& report, const std::string& out_dir) {

@@ -14,6 +14,7 @@
 #include "exit_codes.hpp"
 #include "job_command.hpp"
 #include "job_watch.hpp"
+#include "pressure_fall_line.hpp"
 #include "result_files.hpp"
 #include "service_connection.hpp"
 #include "simulate_request.hpp"
@@ -108,6 +109,7 @@ std::string summary_from_report(const v1::SimulateReport& report) {
   out << "  stretch        mean " << format("%.6g", report.mean_stretch()) << ", max "
       << format("%.6g", report.max_stretch()) << "\n";
   out << "  residual norm  " << format("%.3e", report.residual_norm()) << " N\n";
+  if (report.has_pressure_fall()) out << pressure_fall_line(report.pressure_fall());
   return out.str();
 }
 

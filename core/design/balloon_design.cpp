@@ -8,7 +8,7 @@
 #include "design/closest_from_rest.hpp"
 #include "design/design_driver.hpp"
 #include "design/multiresolution_design.hpp"
-#include "design/pressure_fall_share.hpp"
+#include "material/pressure_fall_share.hpp"
 #include "design/reduced_space_design.hpp"
 #include "design/rest_inflation_check.hpp"
 #include "material/thin_sheet.hpp"

@@ -170,7 +170,7 @@ struct DesignResult {
   /// when it never does.
   std::optional<PressureFallBand> pressure_fall;
   /// The share (0..1) of the handed-back inflated shape's area stretched into that band
-  /// (pressure_fall_share.hpp); none without a design or without a band.
+  /// (material/pressure_fall_share.hpp); none without a design or without a band.
   std::optional<double> pressure_fall_area_share;
 };
 

@@ -5,6 +5,7 @@
 #include <memory>
 #include <utility>
 
+#include "material/pressure_fall_share.hpp"
 #include "material/thin_sheet.hpp"
 #include "mesh/cap_sliver_flips.hpp"
 #include "mesh/centred_frame.hpp"
@@ -203,6 +204,9 @@ InflationResult inflate(const TriMesh& rest, const InflationOptions& options, co
   InflationResult result = inflate_simulated(simulated, initial_guess ? &guess : nullptr);
   result.deformed = simulated.frame.caller(result.deformed);
   result.flipped_cap_slivers = simulated.flipped_cap_slivers;
+  result.pressure_fall = pressure_fall_band(options.material);
+  if (result.converged && result.pressure_fall)
+    result.pressure_fall_area_share = area_share_in_pressure_fall(rest, result.deformed, *result.pressure_fall);
   return result;
 }
 

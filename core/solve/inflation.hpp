@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "material/material.hpp"
+#include "material/pressure_fall_band.hpp"
 #include "mesh/tri_mesh.hpp"
 #include "progress.hpp"
 
@@ -103,6 +104,12 @@ struct InflationResult {
   /// Pressure control: the maxima and minima of the pressure along the volume path from the last
   /// equilibrium to this one, in path order (none under volume control, which reports every state it asks for).
   std::vector<PassedExtremum> passed_extrema;
+  /// Where the rubber's sphere pressure falls as it stretches (material/pressure_fall_band.hpp); none
+  /// when it never does. Set by inflate(), not by InflationPath.
+  std::optional<PressureFallBand> pressure_fall;
+  /// The share (0..1) of the equilibrium's area stretched into that band (material/pressure_fall_share.hpp);
+  /// none unless converged with a band.
+  std::optional<double> pressure_fall_area_share;
   int newton_iterations = 0;
   int factorizations = 0;
   int load_steps = 0;

@@ -15,6 +15,19 @@ std::optional<double> ratio(const std::optional<double>& a, const std::optional<
   return *a / *b;
 }
 
+/// A rubber's band of falling pressure (as stretches and as a sphere's volume ratios) and the share of a
+/// surface in it, when known.
+void fill_pressure_fall(const PressureFallBand& band, const std::optional<double>& area_share,
+                        v1::PressureFallBand& out) {
+  out.set_from_stretch(band.from_stretch);
+  out.set_from_volume_ratio(std::pow(band.from_stretch, 3));
+  if (band.to_stretch) {
+    out.set_to_stretch(*band.to_stretch);
+    out.set_to_volume_ratio(std::pow(*band.to_stretch, 3));
+  }
+  if (area_share) out.set_area_share(*area_share);
+}
+
 }  // namespace
 
 v1::SimulateReport simulate_report(const jobs::SimulateInput& input, const InflationResult& result) {
@@ -48,6 +61,8 @@ v1::SimulateReport simulate_report(const jobs::SimulateInput& input, const Infla
   }
   report.set_flipped_orientation(input.flipped_orientation);
   report.set_message(result.message);
+  if (result.pressure_fall)
+    fill_pressure_fall(*result.pressure_fall, result.pressure_fall_area_share, *report.mutable_pressure_fall());
   report.set_stop_reason(inflation_stop_word(result.stop));
   return report;
 }
@@ -198,16 +213,8 @@ v1::DesignReport design_report(const jobs::DesignInput& input, const jobs::Desig
     out->set_time_s(check->time_s);
   }
 
-  if (const std::optional<PressureFallBand>& band = result.pressure_fall) {
-    v1::PressureFallBand* out = report.mutable_pressure_fall();
-    out->set_from_stretch(band->from_stretch);
-    out->set_from_volume_ratio(std::pow(band->from_stretch, 3));
-    if (band->to_stretch) {
-      out->set_to_stretch(*band->to_stretch);
-      out->set_to_volume_ratio(std::pow(*band->to_stretch, 3));
-    }
-    if (result.pressure_fall_area_share) out->set_area_share(*result.pressure_fall_area_share);
-  }
+  if (result.pressure_fall)
+    fill_pressure_fall(*result.pressure_fall, result.pressure_fall_area_share, *report.mutable_pressure_fall());
 
   v1::ConvergenceLog* log = report.mutable_convergence();
   for (const ConvergenceSample& sample : result.log) {

@@ -99,6 +99,25 @@ TEST_F(SimulateCommand, HumanSummaryStatesUnits) {
   EXPECT_NE(result.out.find("converged"), std::string::npos) << result.out;
 }
 
+TEST_F(SimulateCommand, TheSummarySaysHowMuchOfTheBalloonIsWhereItsRubbersPressureFalls) {
+  // Latex's pressure falls between stretch 1.365 and 3.966; the sphere at x8 stretches by about 2 everywhere.
+  const ProcessResult past = run({"simulate", sphere(), "--material", "latex", "--volume-ratio", "8"});
+  ASSERT_EQ(past.exit_code, 0) << past.err;
+  EXPECT_NE(past.out.find("rubber         its pressure falls as it stretches between stretch 1.365 and 3.966 "
+                          "(volume ratio 2.55 to 62.4); 100% of the inflated surface is stretched there: "),
+            std::string::npos)
+      << past.out;
+  EXPECT_NE(past.out.find("a volume ratio below 2.55 or above 62.4 keeps the sheet out of it"), std::string::npos)
+      << past.out;
+  const ProcessResult json = run({"simulate", sphere(), "--material", "silicone", "--volume-ratio", "8", "--json"});
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  const std::optional<std::string> band = json_field(json.out, "pressure_fall");
+  ASSERT_TRUE(band) << json.out;
+  EXPECT_NEAR(json_number_field(*band, "from_stretch"), 1.406, 2e-3) << *band;
+  EXPECT_NEAR(json_number_field(*band, "to_stretch"), 1.620, 2e-3) << *band;
+  EXPECT_EQ(json_number_field(*band, "area_share"), 0.0) << *band;  // x8 is past silicone's band
+}
+
 TEST_F(SimulateCommand, NotConvergedPrintsTheResultExitsThreeAndWritesNoFile) {
   // 20 kPa is above this neo-Hookean sphere's pressure maximum (about 18.6 kPa): no equilibrium exists.
   const std::string out = s_scratch->file("never.obj");

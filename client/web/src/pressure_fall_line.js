@@ -1,5 +1,5 @@
-// A design report's band of falling pressure in words: where the rubber's pressure falls as it
-// stretches, how much of the inflated design is stretched there and, when most of it is, what that
+// A design or simulate report's band of falling pressure in words: where the rubber's pressure falls as it
+// stretches, how much of the inflated surface is stretched there and, when most of it is, what that
 // does to a balloon and which volume ratios avoid it.
 import { format_number } from './format.js';
 
@@ -7,7 +7,8 @@ import { format_number } from './format.js';
 export const PRESSURE_FALL_ADVICE_SHARE = 0.5;
 
 /**
- * @param {object|undefined} band  DesignReport.pressure_fall (absent when the rubber's pressure never falls)
+ * @param {object|undefined} band  DesignReport or SimulateReport pressure_fall (absent when the rubber's pressure
+ *   never falls)
  * @returns {string}  one line for the job panel's summary, or '' without a band
  */
 export function pressure_fall_line(band) {
@@ -22,7 +23,7 @@ export function pressure_fall_line(band) {
   line += `; ${format_number(100 * band.area_share, 3)} % of the inflated surface is stretched there`;
   if (band.area_share <= PRESSURE_FALL_ADVICE_SHARE) return `${line}.`;
   return `${line}: long or thin parts of a balloon there can bulge one at a time instead of inflating evenly (as a ` +
-    'long party balloon does), and the design may then not reach the target; a volume ratio below ' +
+    'long party balloon does); a volume ratio below ' +
     `${format_number(band.from_volume_ratio, 3)}${has_end ? ` or above ${format_number(band.to_volume_ratio, 3)}` : ''} ` +
     'keeps the sheet out of it.';
 }

@@ -3,18 +3,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
 #include "material/homogeneous_tests.hpp"
 
 namespace balloon {
 namespace {
 
-Material make(MaterialModel model, double a, double b = 0.0, double c = 0.0) {
-  Material m;
-  m.model = model;
-  m.params = {a, b, c};
-  return m;
-}
+/// The law a SPEC names (material.hpp), e.g. "neo-hookean:mu=0.3".
+Material law(const std::string& spec) { return parse_material_spec(spec).value(); }
 
 double slope(const Material& m, double stretch) {
   const double h = 1e-6;
@@ -36,7 +33,7 @@ double mooney_rivlin_extremum(double a, double lo, double hi) {
 }
 
 TEST(PressureFallBand, NeoHookeanFallsForeverPastSeventhRootOfSeven) {
-  const auto band = pressure_fall_band(make(MaterialModel::NeoHookean, 0.3));
+  const auto band = pressure_fall_band(law("neo-hookean:mu=0.3"));
   ASSERT_TRUE(band);
   EXPECT_NEAR(band->from_stretch, std::pow(7.0, 1.0 / 6.0), 1e-7);
   EXPECT_FALSE(band->to_stretch);
@@ -46,15 +43,15 @@ TEST(PressureFallBand, NeoHookeanFallsForeverPastSeventhRootOfSeven) {
 }
 
 TEST(PressureFallBand, MooneyRivlinEndsWhereItsClosedFormHasItsExtrema) {
-  const double a = 0.1;
-  const auto band = pressure_fall_band(make(MaterialModel::MooneyRivlin, 0.2, 0.2 * a));
+  const double a = 0.1;  // C2 / C1
+  const auto band = pressure_fall_band(law("mooney-rivlin:C1=0.2,C2=0.02"));
   ASSERT_TRUE(band);
   ASSERT_TRUE(band->to_stretch);
   // f(l) changes sign between 1.3 and 1.6 (the maximum) and between 1.6 and 4 (the minimum).
   EXPECT_NEAR(band->from_stretch, mooney_rivlin_extremum(a, 1.3, 1.6), 1e-7);
   EXPECT_NEAR(*band->to_stretch, mooney_rivlin_extremum(a, 1.6, 4.0), 1e-7);
   // A larger C2 / C1 (about 0.21 and above) keeps the pressure rising: no band.
-  EXPECT_FALSE(pressure_fall_band(make(MaterialModel::MooneyRivlin, 0.2, 0.2 * 0.3)));
+  EXPECT_FALSE(pressure_fall_band(law("mooney-rivlin:C1=0.2,C2=0.06")));
 }
 
 TEST(PressureFallBand, PresetsFallBetweenTheirMaximumAndMinimum) {
@@ -84,7 +81,7 @@ TEST(PressureFallBand, PresetsFallBetweenTheirMaximumAndMinimum) {
 
 TEST(PressureFallBand, AStrongStiffeningWithoutAMaximumHasNoBand) {
   // k1 = 1 stiffens before the neo-Hookean part can peak: the pressure rises until the law overflows.
-  EXPECT_FALSE(pressure_fall_band(make(MaterialModel::HartSmith, 0.15, 1.0, 0.8)));
+  EXPECT_FALSE(pressure_fall_band(law("hart-smith:G=0.15,k1=1,k2=0.8")));
 }
 
 }  // namespace

@@ -537,6 +537,37 @@ TEST(Inflation, APressureControlledTimeLimitSaysHowFarThePathGot) {
                                 " (volume ratio 2), on the way to " + format_kpa(target_kpa * MPA_PER_KPA));
 }
 
+TEST(Inflation, SaysHowMuchOfTheBalloonIsWhereItsRubbersPressureFalls) {
+  // Every triangle of an inflated sphere stretches by about cbrt(ratio). Latex's pressure falls between
+  // stretch 1.365 and 3.966, silicone's between 1.406 and 1.620: at x8 (stretch 2) latex stands wholly in
+  // its band and silicone past it; at x2 (stretch 1.26) latex stands before it.
+  const TriMesh sphere = make_icosphere(10.0, 2);
+  struct Case {
+    const char* material;
+    double ratio, share;
+  } cases[] = {{"latex", 8.0, 1.0}, {"silicone", 8.0, 0.0}, {"latex", 2.0, 0.0}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(std::string(c.material) + " x" + std::to_string(c.ratio));
+    InflationOptions options;
+    options.material = *parse_material_spec(c.material);
+    options.volume_ratio = c.ratio;
+    const InflationResult result = inflate(sphere, options);
+    ASSERT_TRUE(result.converged) << result.message;
+    ASSERT_TRUE(result.pressure_fall);
+    ASSERT_TRUE(result.pressure_fall_area_share);
+    EXPECT_NEAR(*result.pressure_fall_area_share, c.share, 1e-12);
+  }
+  // No equilibrium (a pressure above Neo-Hookean's maximum, about 19 kPa here): the band, no share.
+  InflationOptions above;
+  above.material = make(MaterialModel::NeoHookean, 0.3);
+  above.control = InflationControl::Pressure;
+  above.pressure_kpa = 100.0;
+  const InflationResult none = inflate(sphere, above);
+  ASSERT_FALSE(none.converged) << none.message;
+  EXPECT_TRUE(none.pressure_fall);
+  EXPECT_FALSE(none.pressure_fall_area_share);
+}
+
 TEST(Inflation, TensionFieldChangesNothingOnATautSphere) {
   // A sphere is in equibiaxial tension everywhere: no triangle is relaxed and the law holds as before.
   const TriMesh sphere = make_icosphere(10.0, 2);

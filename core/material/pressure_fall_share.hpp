@@ -1,6 +1,6 @@
 #pragma once
 /// How much of an inflated balloon is stretched where its rubber loses pressure as it grows
-/// (material/pressure_fall_band.hpp). In that band a balloon's long or thin parts can bulge one at a
+/// (pressure_fall_band.hpp). In that band a balloon's long or thin parts can bulge one at a
 /// time instead of inflating evenly, and a design may then not reach its target; a volume ratio
 /// outside the band keeps the sheet out of it.
 #include "material/pressure_fall_band.hpp"

@@ -1,4 +1,4 @@
-#include "design/pressure_fall_share.hpp"
+#include "material/pressure_fall_share.hpp"
 
 #include <cmath>
 
