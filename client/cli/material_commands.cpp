@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "exit_codes.hpp"
 #include "field_flags.hpp"
+#include "pressure_fall_line.hpp"
 #include "service_connection.hpp"
 
 namespace balloon::cli {
@@ -28,6 +29,9 @@ constexpr const char* HELP =
 void print_material(const v1::Material& material) {
   std::printf("%-16s %s%s\n", material.name().c_str(), material.spec().c_str(), material.preset() ? "  (preset)" : "");
   if (!material.description().empty()) std::printf("%-16s %s\n", "", material.description().c_str());
+  if (material.has_pressure_fall())
+    std::printf("%-16s its sphere pressure falls as it stretches %s\n", "",
+                pressure_fall_range(material.pressure_fall()).c_str());
 }
 
 }  // namespace

@@ -11,6 +11,10 @@ namespace balloon::cli {
 /// and which volume ratios avoid it.
 constexpr double PRESSURE_FALL_ADVICE_SHARE = 0.5;
 
+/// Where the band lies: "between stretch 1.365 and 3.966 (volume ratio 2.55 to 62.4)", or "past stretch
+/// ..." for a band without a minimum.
+std::string pressure_fall_range(const v1::PressureFallBand& band);
+
 /// The line, indented and ended like the other summary lines.
 std::string pressure_fall_line(const v1::PressureFallBand& band);
 

@@ -1,8 +1,9 @@
 #include "service/job_reports.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <limits>
+
+#include "service/pressure_fall_message.hpp"
 
 namespace balloon::service {
 namespace {
@@ -13,19 +14,6 @@ namespace v1 = balloon::v1;
 std::optional<double> ratio(const std::optional<double>& a, const std::optional<double>& b) {
   if (!a || !b || !(*b > 0.0)) return std::nullopt;
   return *a / *b;
-}
-
-/// A rubber's band of falling pressure (as stretches and as a sphere's volume ratios) and the share of a
-/// surface in it, when known.
-void fill_pressure_fall(const PressureFallBand& band, const std::optional<double>& area_share,
-                        v1::PressureFallBand& out) {
-  out.set_from_stretch(band.from_stretch);
-  out.set_from_volume_ratio(std::pow(band.from_stretch, 3));
-  if (band.to_stretch) {
-    out.set_to_stretch(*band.to_stretch);
-    out.set_to_volume_ratio(std::pow(*band.to_stretch, 3));
-  }
-  if (area_share) out.set_area_share(*area_share);
 }
 
 }  // namespace

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <optional>
+
+#include "service/pressure_fall_message.hpp"
 
 namespace balloon::service {
 namespace {
@@ -15,6 +18,8 @@ void fill_constants(const Material& material, balloon::v1::Material* reply) {
   reply->set_model(model_name(material.model));
   const auto names = parameter_names(material.model);
   for (std::size_t i = 0; i < names.size(); ++i) (*reply->mutable_params())[names[i]] = material.params[i];
+  if (const std::optional<PressureFallBand> band = pressure_fall_band(material))
+    fill_pressure_fall(*band, std::nullopt, *reply->mutable_pressure_fall());
 }
 
 void fill_preset(const std::string& name, balloon::v1::Material* reply) {

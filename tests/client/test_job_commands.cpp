@@ -1,6 +1,7 @@
 // `balloon submit`, `balloon jobs ...` and `balloon materials ...` against the embedded server, from outside.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -78,6 +79,17 @@ TEST(JobCommands, MaterialsLibrary) {
   const ProcessResult shown = run_balloon(scratch, {"materials", "show", "soft", "--json"});
   ASSERT_EQ(shown.exit_code, 0) << shown.err;
   EXPECT_EQ(json_field(shown.out, "spec"), "\"neo-hookean:mu=0.2\"");
+  // Where each law's sphere pressure falls as it stretches: Neo-Hookean past 7^(1/6), for good.
+  const std::optional<std::string> band = json_field(shown.out, "pressure_fall");
+  ASSERT_TRUE(band) << shown.out;
+  EXPECT_NEAR(json_number_field(*band, "from_stretch"), std::pow(7.0, 1.0 / 6.0), 1e-6) << *band;
+  EXPECT_FALSE(json_field(*band, "to_stretch")) << *band;
+  const ProcessResult latex = run_balloon(scratch, {"materials", "show", "latex"});
+  ASSERT_EQ(latex.exit_code, 0) << latex.err;
+  EXPECT_NE(latex.out.find("its sphere pressure falls as it stretches between stretch 1.365 and 3.966 (volume "
+                           "ratio 2.55 to 62.4)"),
+            std::string::npos)
+      << latex.out;
 
   // A stored material works as --material by name.
   ASSERT_EQ(run_balloon(scratch, {"mesh", "sphere", "--radius", "10", "--subdivisions", "2", "--out", scratch.file("s.obj")})

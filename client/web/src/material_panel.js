@@ -3,6 +3,7 @@
 import { show_error } from './field_errors.js';
 import { format_number } from './format.js';
 import { ordered_params, param_label } from './material_params.js';
+import { pressure_fall_line } from './pressure_fall_line.js';
 
 export class MaterialPanel {
   /**
@@ -86,6 +87,13 @@ export class MaterialPanel {
       description.className = 'hint';
       description.textContent = material.description.split('\n')[0];
       info.appendChild(description);
+    }
+    const band = pressure_fall_line(material.pressure_fall);
+    if (band) {
+      const hint = document.createElement('p');
+      hint.className = 'hint';
+      hint.textContent = `${band} Inflated to a volume ratio in that range, long or thin parts can bulge one at a time.`;
+      info.appendChild(hint);
     }
   }
 }
