@@ -2,16 +2,9 @@
 
 #include <cmath>
 
+#include "mesh/mesh_geometry.hpp"
+
 namespace balloon {
-
-namespace {
-
-double triangle_area(const Positions& vertices, const Eigen::Vector3i& face) {
-  const Eigen::RowVector3d a = vertices.row(face[0]), b = vertices.row(face[1]), c = vertices.row(face[2]);
-  return 0.5 * (b - a).cross(c - a).norm();
-}
-
-}  // namespace
 
 double area_share_in_pressure_fall(const TriMesh& rest, const Positions& inflated, const PressureFallBand& band) {
   double total = 0.0, in_band = 0.0;

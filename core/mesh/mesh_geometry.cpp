@@ -27,15 +27,15 @@ double enclosed_volume(const Positions& vertices, const Faces& faces) {
   return six_volume / 6.0;
 }
 
+double triangle_area(const Positions& vertices, const Eigen::Vector3i& face) {
+  const Eigen::RowVector3d a = vertices.row(face[0]), b = vertices.row(face[1]), c = vertices.row(face[2]);
+  return 0.5 * (b - a).cross(c - a).norm();
+}
+
 double surface_area(const Positions& vertices, const Faces& faces) {
-  double twice_area = 0.0;
-  for (Eigen::Index f = 0; f < faces.rows(); ++f) {
-    const Eigen::RowVector3d a = vertices.row(faces(f, 0));
-    const Eigen::RowVector3d b = vertices.row(faces(f, 1));
-    const Eigen::RowVector3d c = vertices.row(faces(f, 2));
-    twice_area += (b - a).cross(c - a).norm();
-  }
-  return twice_area / 2.0;
+  double area = 0.0;
+  for (Eigen::Index f = 0; f < faces.rows(); ++f) area += triangle_area(vertices, faces.row(f).transpose());
+  return area;
 }
 
 double bounding_box_diagonal(const Positions& vertices) {

@@ -14,6 +14,9 @@ namespace balloon {
 /// for an open mesh it depends on that reference point.
 double enclosed_volume(const Positions& vertices, const Faces& faces);
 
+/// Area (mm^2) of one triangle, face[0..2], over positions V (#V x 3, mm).
+double triangle_area(const Positions& vertices, const Eigen::Vector3i& face);
+
 /// Total area (mm^2) of the triangles F (#F x 3) over positions V (#V x 3, mm).
 double surface_area(const Positions& vertices, const Faces& faces);
 
